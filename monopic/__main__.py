@@ -1,0 +1,5 @@
+import sys
+
+from monopic.cli.main import main
+
+sys.exit(main())

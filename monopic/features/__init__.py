@@ -1,0 +1,1 @@
+"""Motion features from pose landmarks: orientation, image velocity, ground motion."""

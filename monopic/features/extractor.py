@@ -1,0 +1,93 @@
+"""Pose -> motion features, frame after frame, as the authors' pipeline computes them."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from monopic.features.ground import GroundMotion
+from monopic.features.motion import VelocityEstimator
+from monopic.features.orientation import facing_angle
+from monopic.features.smoothing import Kalman1D
+from monopic.frame import EgoState
+from monopic.pose.landmarks import Pose
+from monopic.pose.skeleton import FOOT_LANDMARKS, LEFT_SHOULDER, RIGHT_SHOULDER
+from monopic.predict.base import Features, GroundFeatures
+
+# Foot landmarks below this visibility are not trusted for the foot point.
+MIN_FOOT_VISIBILITY = 0.5
+
+
+def foot_point(pose: Pose, image_height: int) -> tuple[float, float]:
+    """Where the pedestrian stands on the image.
+
+    The lowest visible ankle/heel/toe row at the mean column of the visible foot points;
+    when the feet are not visible (cut off by the frame, occluded), the bottom of the
+    landmark box under its centre.
+    """
+    idx = [i for i in FOOT_LANDMARKS if pose.visibility[i] >= MIN_FOOT_VISIBILITY]
+    pts = pose.landmarks[idx, :2]
+    if len(idx) >= 2 and np.all(pts[:, 1] < image_height):
+        return float(pts[:, 0].mean()), float(pts[:, 1].max())
+    x0, _, x1, y1 = pose.box
+    return (x0 + x1) / 2, y1
+
+
+@dataclass
+class FeatureExtractor:
+    """Stateful per-track feature computation; reset it when the track is lost for long."""
+
+    velocity_window: int = 4
+    velocity_average: int = 4
+    max_gap: float = 0.5  # seconds without a pose before the track's history is dropped
+    phi_filter: Kalman1D = field(default_factory=Kalman1D)
+    _image_velocity: VelocityEstimator = field(init=False)
+    _ground: GroundMotion = field(init=False)
+    _last_seen: float | None = field(default=None, init=False)
+
+    def __post_init__(self) -> None:
+        self._image_velocity = VelocityEstimator(self.velocity_window, self.velocity_average)
+        self._ground = GroundMotion(self.velocity_window, self.velocity_average)
+
+    def update(
+        self, timestamp: float, pose: Pose | None, image_height: int, ego: EgoState | None = None
+    ) -> Features | None:
+        """Features for this frame, or None when no pedestrian is seen."""
+        if ego is not None:
+            self._ground.observe_ego(timestamp, ego)
+        if pose is None:
+            if self._last_seen is not None and timestamp - self._last_seen > self.max_gap:
+                self._reset_track()
+            return None
+        if self._last_seen is not None and timestamp - self._last_seen > self.max_gap:
+            self._reset_track()
+        self._last_seen = timestamp
+
+        x0, y0, x1, y1 = pose.box
+        center = ((x0 + x1) / 2, (y0 + y1) / 2)
+        foot = foot_point(pose, image_height)
+        phi_raw = facing_angle(pose.landmarks[LEFT_SHOULDER], pose.landmarks[RIGHT_SHOULDER])
+        phi = self.phi_filter.update(phi_raw)
+        vx, vy = self._image_velocity.update(timestamp, *center)
+        ground = None
+        if ego is not None:
+            g = self._ground.update(timestamp, ego, foot)
+            if g is not None:
+                ground = GroundFeatures(position=g[0], velocity=g[1], camera=ego.camera)
+        return Features(
+            timestamp=timestamp,
+            center=center,
+            foot=foot,
+            apparent_height=pose.height,
+            phi=phi,
+            vx=vx,
+            vy=vy,
+            ground=ground,
+            phi_raw=phi_raw,
+        )
+
+    def _reset_track(self) -> None:
+        self._image_velocity.reset()
+        self._ground.reset_track()
+        self.phi_filter.reset()

@@ -1,0 +1,1 @@
+"""BlazePose with onnxruntime: person detector, landmark model and a MediaPipe-like tracker."""

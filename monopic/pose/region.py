@@ -1,0 +1,84 @@
+"""Rotated square regions of interest, as MediaPipe builds them, and the crops they define.
+
+A region is a square in pixels, centred on a body point and rotated so that the body's
+axis (hip -> shoulder-ish keypoint) points up in the crop. Rotation follows MediaPipe:
+r = target - atan2(-(y1 - y0), x1 - x0) with target 90 degrees, so an upright person has
+r = 0; a crop point p (0..size) maps to the image as C + Rot(r) @ (p / size - 0.5) * side.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import cv2
+import numpy as np
+
+# MediaPipe's pose graphs enlarge the keypoint-aligned square by 1.25 on each side.
+DEFAULT_SCALE = 1.25
+
+
+@dataclass(frozen=True)
+class Region:
+    """Square region: centre (px), side (px), rotation (rad, MediaPipe convention)."""
+
+    cx: float
+    cy: float
+    side: float
+    rotation: float = 0.0
+
+    @classmethod
+    def from_keypoints(
+        cls,
+        centre: tuple[float, float],
+        scale_point: tuple[float, float],
+        scale: float = DEFAULT_SCALE,
+        target_angle: float = math.pi / 2,
+    ) -> Region:
+        """MediaPipe's alignment-points rect: radius = |scale_point - centre|, then scaled."""
+        (x0, y0), (x1, y1) = centre, scale_point
+        radius = math.hypot(x1 - x0, y1 - y0)
+        rotation = _normalise(target_angle - math.atan2(-(y1 - y0), x1 - x0))
+        return cls(x0, y0, 2 * radius * scale, rotation)
+
+    @property
+    def valid(self) -> bool:
+        return all(math.isfinite(v) for v in (self.cx, self.cy, self.side, self.rotation)) and (
+            self.side > 1.0
+        )
+
+    def crop_to_image(self, size: int) -> np.ndarray:
+        """2x3 affine map from continuous crop coordinates (0..size) to image coordinates."""
+        c, s = math.cos(self.rotation), math.sin(self.rotation)
+        k = self.side / size
+        a = np.array([[c * k, -s * k], [s * k, c * k]])
+        b = np.array([self.cx, self.cy]) - a @ np.array([size / 2, size / 2])
+        return np.hstack([a, b[:, None]])
+
+    def crop(self, image: np.ndarray, size: int) -> np.ndarray:
+        """The region resampled to size x size (zero outside the image)."""
+        m = self.crop_to_image(size)
+        # warpAffine samples pixel centres: shift by half a pixel on both sides.
+        m_idx = m.copy()
+        m_idx[:, 2] += m[:, :2] @ np.array([0.5, 0.5]) - 0.5
+        return cv2.warpAffine(
+            image,
+            m_idx,
+            (size, size),
+            flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
+            borderMode=cv2.BORDER_CONSTANT,
+            borderValue=(0, 0, 0),
+        )
+
+    def to_image(self, points: np.ndarray, size: int) -> np.ndarray:
+        """Crop coordinates (N, 2) in 0..size to image pixels (N, 2)."""
+        m = self.crop_to_image(size)
+        return np.asarray(points, dtype=float) @ m[:, :2].T + m[:, 2]
+
+    def corners(self) -> np.ndarray:
+        """The four corners in image pixels (for drawing)."""
+        return self.to_image(np.array([[0, 0], [1, 0], [1, 1], [0, 1]], dtype=float), 1)
+
+
+def _normalise(angle: float) -> float:
+    return angle - 2 * math.pi * math.floor((angle + math.pi) / (2 * math.pi))

@@ -1,0 +1,39 @@
+"""onnxruntime sessions with an explicit thread budget.
+
+Parallel sweep workers each run their own pipeline; sessions that spin-wait or take every
+core would fight, so the thread count is always explicit and spinning is off.
+"""
+
+from __future__ import annotations
+
+from importlib import resources
+from pathlib import Path
+
+import onnxruntime as ort
+
+DETECTOR_FILE = "pose_detection.onnx"
+LANDMARK_FILE = "pose_landmark_full.onnx"
+
+
+def model_path(name: str) -> Path:
+    """Path of a model shipped inside the package (monopic/pose/models/)."""
+    path = Path(str(resources.files("monopic.pose") / "models" / name))
+    if not path.is_file():
+        raise FileNotFoundError(
+            f"pose model {path} is missing: reinstall the package or run `make models`"
+        )
+    return path
+
+
+def make_session(path: Path, threads: int = 1) -> ort.InferenceSession:
+    """A CPU session using exactly `threads` intra-op threads and no spin-waiting."""
+    if threads < 1:
+        raise ValueError(f"threads must be >= 1, got {threads}")
+    opts = ort.SessionOptions()
+    opts.intra_op_num_threads = threads
+    opts.inter_op_num_threads = 1
+    opts.execution_mode = ort.ExecutionMode.ORT_SEQUENTIAL
+    opts.graph_optimization_level = ort.GraphOptimizationLevel.ORT_ENABLE_ALL
+    opts.add_session_config_entry("session.intra_op.allow_spinning", "0")
+    opts.add_session_config_entry("session.inter_op.allow_spinning", "0")
+    return ort.InferenceSession(str(path), sess_options=opts, providers=["CPUExecutionProvider"])

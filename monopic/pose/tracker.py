@@ -1,0 +1,106 @@
+"""One-pedestrian tracker wired like MediaPipe's pose solution.
+
+Acquire: run the detector on the whole frame, then on square tiles of decreasing size
+until someone is found (far pedestrians are too small for the whole frame squeezed into
+224 px); keep the most confident detection. Track: crop the rotated region, run the
+landmark model, take the next frame's region from this frame's auxiliary points. When the
+pose flag drops, the person is lost and the detector runs again (in the same frame).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from monopic.pose.detector import PoseDetector, Window, tile_windows
+from monopic.pose.landmarks import LandmarkModel, Pose
+from monopic.pose.region import DEFAULT_SCALE, Region
+
+
+@dataclass(frozen=True)
+class TrackerConfig:
+    threads: int = 1  # onnxruntime intra-op threads per model
+    min_detection_score: float = 0.5
+    min_pose_score: float = 0.5  # pose flag below this: person lost
+    region_scale: float = DEFAULT_SCALE
+    # Square tile sides tried, in order, after the whole frame finds nobody.
+    acquire_tiles: tuple[int, ...] = (432, 288, 216)
+    tile_overlap: float = 0.25
+
+
+@dataclass(frozen=True)
+class PoseResult:
+    """What the tracker saw in one frame: a pose or explicitly none."""
+
+    pose: Pose | None
+    detector_runs: int = 0  # detector passes (windows) spent this frame
+    detect_ms: float = 0.0
+    landmark_ms: float = 0.0
+
+    @property
+    def found(self) -> bool:
+        return self.pose is not None
+
+
+@dataclass
+class PoseTracker:
+    config: TrackerConfig = field(default_factory=TrackerConfig)
+
+    def __post_init__(self) -> None:
+        self.detector = PoseDetector(self.config.threads, self.config.min_detection_score)
+        self.landmarks = LandmarkModel(self.config.threads)
+        self._region: Region | None = None
+
+    def reset(self) -> None:
+        """Forget the tracked person (e.g. at a cut in the video)."""
+        self._region = None
+
+    def process(self, image: np.ndarray, region: Region | None = None) -> PoseResult:
+        """Landmarks of the tracked person in this RGB frame.
+
+        `region`, when given, replaces detection and tracking for this frame (used to feed
+        a known crop, e.g. for ablations); the next frame tracks from its result.
+        """
+        runs, detect_ms, landmark_ms = 0, 0.0, 0.0
+        if region is not None:
+            self._region = region
+        for attempt in range(2):
+            if self._region is None:
+                t0 = time.perf_counter()
+                self._region, runs_now = self._acquire(image)
+                runs += runs_now
+                detect_ms += (time.perf_counter() - t0) * 1e3
+                if self._region is None:
+                    break
+            t0 = time.perf_counter()
+            pose = self.landmarks.run(image, self._region)
+            landmark_ms += (time.perf_counter() - t0) * 1e3
+            if pose.score >= self.config.min_pose_score:
+                next_region = pose.next_region(self.config.region_scale)
+                self._region = next_region if next_region.valid else None
+                return PoseResult(pose, runs, detect_ms, landmark_ms)
+            self._region = None
+            if attempt == 0 and runs > 0:
+                break  # fresh detection already failed the landmark check
+        return PoseResult(None, runs, detect_ms, landmark_ms)
+
+    def _acquire(self, image: np.ndarray) -> tuple[Region | None, int]:
+        h, w = image.shape[:2]
+        levels: list[list[Window]] = [[Window(0, 0, w, h)]]
+        for tile in self.config.acquire_tiles:
+            if tile < max(w, h):
+                levels.append(tile_windows(w, h, tile, self.config.tile_overlap))
+        runs = 0
+        for windows in levels:
+            runs += len(windows)
+            dets = self.detector.detect(image, windows)
+            if dets:
+                best = dets[0]
+                region = Region.from_keypoints(
+                    tuple(best.keypoints[0]), tuple(best.keypoints[1]), self.config.region_scale
+                )
+                if region.valid:
+                    return region, runs
+        return None, runs

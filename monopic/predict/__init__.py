@@ -1,0 +1,1 @@
+"""Predictors: features in, motion case and future position out."""
