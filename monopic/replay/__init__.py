@@ -1,0 +1,1 @@
+"""Replaying logged tracks in the authors' CSV format through our stages, and scoring them."""

@@ -1,0 +1,143 @@
+"""Reader for the authors' per-frame CSV logs, strict about every cell.
+
+Format (shared/data/authors-testdata/README.md): a header line, then one row per
+processed frame with the columns in COLUMNS (extra columns are allowed and ignored).
+Every cell of those columns must be a finite number, time must increase from row to row,
+occupiedHeights must be positive, and a log needs at least MIN_ROWS rows. Anything else is
+a UserError naming the file, the line (1-based line of the file; the header is line 1)
+and the column.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from monopic.errors import UserError
+
+COLUMNS = (
+    "frameNumber",
+    "windowSize",
+    "XYError",
+    "timeToFuture",
+    "time",
+    "fps",
+    "currentCenterX",
+    "currentCenterY",
+    "leftShoulderX",
+    "leftShoulderY",
+    "rightShoulderX",
+    "rightShoulderY",
+    "angleOfApproach",
+    "XFrameSpeed",
+    "YFrameSpeed",
+    "occupiedHeights",
+    "predictedX",
+    "predictedY",
+)
+MIN_ROWS = 2
+# occupiedHeights is the landmarks' vertical extent divided by the 432 px frame height.
+FRAME_HEIGHT_PX = 432.0
+
+
+@dataclass(frozen=True)
+class AuthorsLog:
+    """One log, column by column (arrays of equal length, one entry per data row)."""
+
+    path: Path
+    sha256: str
+    time: np.ndarray
+    center_x: np.ndarray
+    center_y: np.ndarray
+    phi: np.ndarray
+    occupied: np.ndarray
+    predicted_x: np.ndarray
+    predicted_y: np.ndarray
+
+    @property
+    def name(self) -> str:
+        return self.path.name
+
+    def __len__(self) -> int:
+        return int(self.time.size)
+
+    @property
+    def apparent_height(self) -> np.ndarray:
+        """Apparent height in pixels."""
+        return self.occupied * FRAME_HEIGHT_PX
+
+
+def read_log(path: Path) -> AuthorsLog:
+    """Parse and validate one log; UserError on any defect."""
+    path = Path(path)
+    try:
+        raw = path.read_bytes()
+    except OSError as err:
+        raise UserError(f"{path}: cannot read: {err.strerror or err}") from err
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as err:
+        raise UserError(f"{path}: not UTF-8 text (byte {err.start})") from err
+    if not text.strip():
+        raise UserError(f"{path}: empty file (expected a header line with {COLUMNS[4]!r} etc.)")
+    reader = csv.reader(text.splitlines())
+    header = [h.strip() for h in next(reader)]
+    missing = [c for c in COLUMNS if c not in header]
+    if missing:
+        raise UserError(f"{path}: line 1 (header): missing column {missing[0]!r}")
+    index = {c: header.index(c) for c in COLUMNS}
+    values: dict[str, list[float]] = {c: [] for c in COLUMNS}
+    line = 1
+    for cells in reader:
+        line = reader.line_num
+        if not cells or all(not c.strip() for c in cells):
+            continue  # blank line (e.g. trailing newline)
+        if len(cells) != len(header):
+            raise UserError(
+                f"{path}: line {line}: {len(cells)} cells, the header has {len(header)}"
+            )
+        for c in COLUMNS:
+            cell = cells[index[c]].strip()
+            try:
+                v = float(cell)
+            except ValueError:
+                raise UserError(
+                    f"{path}: line {line}, column {c!r}: {cell!r} is not a number"
+                ) from None
+            if not math.isfinite(v):
+                raise UserError(f"{path}: line {line}, column {c!r}: {cell!r} is not finite")
+            values[c].append(v)
+        t = values["time"]
+        if len(t) >= 2 and t[-1] <= t[-2]:
+            raise UserError(
+                f"{path}: line {line}, column 'time': {t[-1]!r} does not come after the "
+                f"previous row's {t[-2]!r}"
+            )
+        if values["occupiedHeights"][-1] <= 0:
+            raise UserError(
+                f"{path}: line {line}, column 'occupiedHeights': "
+                f"{values['occupiedHeights'][-1]!r} is not positive"
+            )
+    n = len(values["time"])
+    if n < MIN_ROWS:
+        raise UserError(
+            f"{path}: line {line} (end of file): too few rows: {n} data rows, "
+            f"at least {MIN_ROWS} needed"
+        )
+    arr = {c: np.asarray(v, dtype=float) for c, v in values.items()}
+    return AuthorsLog(
+        path=path,
+        sha256=hashlib.sha256(raw).hexdigest(),
+        time=arr["time"],
+        center_x=arr["currentCenterX"],
+        center_y=arr["currentCenterY"],
+        phi=arr["angleOfApproach"],
+        occupied=arr["occupiedHeights"],
+        predicted_x=arr["predictedX"],
+        predicted_y=arr["predictedY"],
+    )

@@ -1,0 +1,87 @@
+"""Human-readable views of a trained model: summary, gain table, text tree, DOT."""
+
+from __future__ import annotations
+
+from monopic.cases import Case
+from monopic.predict.base import Mode
+from monopic.tree.id3 import Node, Value, render_dot, render_text
+from monopic.tree.model import Placement, TreeModel, TreePredictor
+from monopic.tree.opcount import ops_report
+
+# The paper's root information gains ("ID3 Classification"), image mode.
+PAPER_ROOT_GAINS = {"vx": 0.022, "vy": 0.014, "phi": 0.004}
+
+
+def gain_table(model: TreeModel) -> str:
+    """Root information gain per attribute, highest first, beside the paper's figures."""
+    n = model.tree.root.n
+    lines = [
+        f"Information gain at the root ({n} training rows, label entropy "
+        f"{model.root_entropy:.3f} bits):",
+        f"  {'attribute':<10} {'ours':>7} {'paper':>7}",
+    ]
+    for a, g in sorted(model.root_gains, key=lambda ag: -ag[1]):
+        paper = PAPER_ROOT_GAINS.get(a) if model.mode is Mode.IMAGE else None
+        lines.append(f"  {a:<10} {g:7.3f} {'-' if paper is None else f'{paper:.3f}':>7}")
+    return "\n".join(lines)
+
+
+def _value_text(model: TreeModel, attribute: str, value: Value) -> str:
+    desc = model.discretiser.binner(attribute).describe(int(value))
+    return f"{attribute} = {value} ({desc})"
+
+
+def _node_text(model: TreeModel, node: Node) -> str:
+    case = Case(node.label)
+    text = f"case {int(case)} {case.label} (n={node.n}, {node.purity:.0%})"
+    if node.mean is not None:
+        unit = "heights" if model.mode is Mode.IMAGE else "m"
+        text += f", moves ({node.mean[0]:+.2f}, {node.mean[1]:+.2f}) {unit}"
+    if not node.is_leaf:
+        text += f"; split on {node.attribute} (gain {node.gain:.3f})"
+    return text
+
+
+def tree_text(model: TreeModel) -> str:
+    return render_text(
+        model.tree,
+        describe_value=lambda a, v: _value_text(model, a, v),
+        describe_node=lambda node: _node_text(model, node),
+    )
+
+
+def tree_dot(model: TreeModel) -> str:
+    def node_label(node: Node) -> str:
+        case = Case(node.label)
+        text = f"case {int(case)}: {case.label}\nn={node.n} ({node.purity:.0%})"
+        if node.mean is not None:
+            text += f"\nmoves ({node.mean[0]:+.2f}, {node.mean[1]:+.2f})"
+        return text
+
+    return render_dot(
+        model.tree,
+        describe_value=lambda a, v: f"{v}: {model.discretiser.binner(a).describe(int(v))}",
+        describe_node=node_label,
+        name=f"monopic-{model.mode.value}-tree",
+    )
+
+
+def summary(model: TreeModel) -> str:
+    """Everything `monopic tree show` prints."""
+    data = model.provenance.get("data", [])
+    trained = ", ".join(f"{d['name']} ({d['training_rows']} rows)" for d in data) or "unknown"
+    unit = "apparent heights" if model.mode is Mode.IMAGE else "metres"
+    parts = [
+        f"ID3 tree, {model.mode.value} mode, horizon {model.horizon:g} s, "
+        f"discretiser {model.discretiser.name}, depth {model.tree.depth}, "
+        f"{sum(1 for n in model.tree.nodes() if n.is_leaf)} leaves; "
+        f"leaf displacements in {unit}",
+        f"Trained on: {trained}",
+        "",
+        gain_table(model),
+        "",
+        tree_text(model),
+    ]
+    if model.mode is Mode.IMAGE:
+        parts += ["", ops_report(TreePredictor(model, Placement.LEAF))]
+    return "\n".join(parts)

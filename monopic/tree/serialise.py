@@ -1,0 +1,123 @@
+"""Versioned JSON for trained trees, and the default tree shipped with the package.
+
+The file is plain JSON so anyone can read the tree without our code. Floats are written
+with Python's shortest round-trip repr, so load(save(model)) == model exactly. A file
+with another format name or version is refused with a clear message rather than guessed.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import tempfile
+from importlib import resources
+from pathlib import Path
+from typing import Any
+
+from monopic.cases import Case
+from monopic.errors import UserError
+from monopic.predict.base import Mode
+from monopic.tree.discretise import Discretiser
+from monopic.tree.id3 import DecisionTree
+from monopic.tree.model import TreeModel
+
+FORMAT = "monopic-id3-tree"
+VERSION = 1
+DEFAULT_TREE_NAME = "default_tree.json"
+
+
+def model_to_json(model: TreeModel) -> dict[str, Any]:
+    return {
+        "format": FORMAT,
+        "version": VERSION,
+        "mode": model.mode.value,
+        "horizon_s": model.horizon,
+        "displacement_unit": model.displacement_unit,
+        "discretiser": model.discretiser.to_json(),
+        "root_entropy": model.root_entropy,
+        "root_gains": [[a, g] for a, g in model.root_gains],
+        "provenance": model.provenance,
+        "tree": model.tree.to_json(),
+    }
+
+
+def model_from_json(data: Any) -> TreeModel:
+    """Inverse of `model_to_json`; ValueError naming what is wrong."""
+    if not isinstance(data, dict):
+        raise ValueError("not a JSON object")
+    if data.get("format") != FORMAT:
+        raise ValueError(f"format is {data.get('format')!r}, expected {FORMAT!r}")
+    if data.get("version") != VERSION:
+        raise ValueError(f"version {data.get('version')!r} is not supported (only {VERSION})")
+    try:
+        mode = Mode(data["mode"])
+        model = TreeModel(
+            mode=mode,
+            horizon=float(data["horizon_s"]),
+            discretiser=Discretiser.from_json(data["discretiser"]),
+            tree=DecisionTree.from_json(data["tree"]),
+            root_entropy=float(data["root_entropy"]),
+            root_gains=tuple((str(a), float(g)) for a, g in data["root_gains"]),
+            provenance=dict(data["provenance"]),
+        )
+    except (KeyError, TypeError) as err:
+        raise ValueError(f"malformed tree: {type(err).__name__} {err}") from err
+    if data.get("displacement_unit") != model.displacement_unit:
+        raise ValueError(
+            f"displacement_unit {data.get('displacement_unit')!r} does not match mode {mode.value}"
+        )
+    if set(model.tree.attributes) != set(model.discretiser.attributes):
+        raise ValueError("the tree's attributes differ from the discretiser's")
+    valid = {int(c) for c in Case}
+    for node in model.tree.nodes():
+        if node.label not in valid or any(lab not in valid for lab, _ in node.counts):
+            raise ValueError(f"node label {node.label!r} is not a case number 1-9")
+        if node.mean is not None and len(node.mean) != 2:
+            raise ValueError(f"node displacement {node.mean!r} is not an (x, y) pair")
+    return model
+
+
+def dumps(model: TreeModel) -> str:
+    return json.dumps(model_to_json(model), indent=1, allow_nan=False) + "\n"
+
+
+def write_atomically(path: Path, text: str) -> None:
+    """Write to a temporary file beside `path`, then rename: never a half-written file."""
+    path = Path(path)
+    fd, tmp = tempfile.mkstemp(dir=path.parent or Path("."), prefix=f".{path.name}.", suffix=".tmp")
+    try:
+        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
+            fh.write(text)
+        os.replace(tmp, path)
+    except BaseException:
+        Path(tmp).unlink(missing_ok=True)
+        raise
+
+
+def save_model(model: TreeModel, path: Path) -> None:
+    write_atomically(Path(path), dumps(model))
+
+
+def load_model(path: Path) -> TreeModel:
+    """Read a tree file; UserError (naming the file) if it is unreadable or malformed."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as err:
+        raise UserError(f"{path}: cannot read tree file: {err.strerror or err}") from err
+    return _parse(text, str(path))
+
+
+def _parse(text: str, where: str) -> TreeModel:
+    try:
+        return model_from_json(json.loads(text))
+    except json.JSONDecodeError as err:
+        raise UserError(f"{where}: line {err.lineno}: not valid JSON: {err.msg}") from err
+    except ValueError as err:
+        raise UserError(f"{where}: {err}") from err
+
+
+def load_default_model() -> TreeModel:
+    """The tree shipped inside the package (see monopic/tree/DEFAULT_TREE.md)."""
+    ref = resources.files("monopic.tree").joinpath(DEFAULT_TREE_NAME)
+    return _parse(ref.read_text(encoding="utf-8"), f"package data {DEFAULT_TREE_NAME}")
