@@ -42,9 +42,7 @@ def test_behind_camera_projects_to_nan():
     assert np.all(np.isnan(CAM.project(np.array([-1.0, 0.0, 1.0]))))
 
 
-@given(
-    st.floats(50, 700), st.floats(50, 400), st.floats(20, 400), st.floats(-math.pi, math.pi)
-)
+@given(st.floats(50, 700), st.floats(50, 400), st.floats(20, 400), st.floats(-math.pi, math.pi))
 def test_region_crop_and_back_are_inverse(cx, cy, side, rot):
     r = Region(cx, cy, side, rot)
     crop_pts = np.array([[0, 0], [256, 0], [128, 128], [10, 200]], dtype=float)

@@ -1,0 +1,162 @@
+"""`monopic video`: the pipeline on any video, with annotated video, CSV and rerun outputs."""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import time
+from contextlib import ExitStack
+from pathlib import Path
+
+import cv2
+from tqdm import tqdm
+
+from monopic.camera import CameraModel
+from monopic.cli.args import non_negative_float, positive_float, positive_int
+from monopic.errors import UserError
+from monopic.frame import EgoState
+from monopic.output import atomic_path
+from monopic.overlay import draw
+from monopic.pipeline import FrameResult, Pipeline, PipelineConfig, Variant
+from monopic.pose.skeleton import LEFT_SHOULDER, RIGHT_SHOULDER
+from monopic.pose.tracker import TrackerConfig
+from monopic.predict.base import Mode
+from monopic.predict.rules import IMAGE_DEAD_ZONE_PX_S
+from monopic.video import VideoSource
+
+# The authors' log columns (their README), then ours.
+AUTHORS_COLUMNS = (
+    "frameNumber", "windowSize", "XYError", "timeToFuture", "time", "fps",
+    "currentCenterX", "currentCenterY", "leftShoulderX", "leftShoulderY",
+    "rightShoulderX", "rightShoulderY", "angleOfApproach", "XFrameSpeed", "YFrameSpeed",
+    "occupiedHeights", "predictedX", "predictedY",
+)  # fmt: skip
+OUR_COLUMNS = (
+    "case", "caseName", "phiRaw", "footX", "footY", "predictedFootX", "predictedFootY",
+    "apparentHeight", "poseScore", "collision", "risk", "groundX", "groundY", "groundVx",
+    "groundVy", "predictedGroundX", "predictedGroundY", "detectorRuns", "detectMs",
+    "landmarksMs", "featuresMs", "predictMs", "warningMs", "totalMs",
+)  # fmt: skip
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("video", help="run the pipeline on a video file or camera")
+    p.add_argument("input", help="video file OpenCV reads, or a camera index such as 0")
+    p.add_argument("--variant", choices=[v.value for v in Variant], default="warning")
+    p.add_argument("--out", type=Path, help="annotated video to write (.mp4)")
+    p.add_argument("--csv", type=Path, help="per-frame CSV (authors' columns plus ours)")
+    p.add_argument("--rrd", type=Path, help="rerun recording to write")
+    p.add_argument("--horizon", type=positive_float, default=1.0, help="seconds ahead (1.0)")
+    p.add_argument("--mode", choices=[m.value for m in Mode], default="image")
+    p.add_argument("--threads", type=positive_int, default=1, help="onnxruntime threads")
+    g = p.add_argument_group("camera geometry (needed for ground mode and the projected zone)")
+    g.add_argument("--fov", type=positive_float, help="vertical field of view, degrees")
+    g.add_argument("--camera-height", type=positive_float, help="metres above the ground")
+    g.add_argument("--pitch", type=float, default=0.0, help="degrees, positive looks down")
+    g.add_argument("--speed", type=non_negative_float, default=0.0, help="robot speed, m/s")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    if args.variant not in {v.value for v in Variant}:
+        raise UserError(f"unknown variant {args.variant!r}")
+    source = VideoSource(args.input)
+    ego = _ego(args, source.width, source.height)
+    source.ego = ego
+    mode = Mode(args.mode)
+    if mode is Mode.GROUND and ego is None:
+        raise UserError("--mode ground needs the camera geometry: --fov and --camera-height")
+    for out in (args.out, args.csv, args.rrd):
+        if out is not None and not out.parent.is_dir():
+            raise UserError(f"{out}: its folder {out.parent} does not exist")
+    pipeline = Pipeline(
+        PipelineConfig(horizon=args.horizon, mode=mode, tracker=TrackerConfig(threads=args.threads))
+    )
+    variant = Variant(args.variant)
+    found = frames = 0
+    with ExitStack() as stack:
+        writer = csv_writer = recording = None
+        if args.out is not None:
+            tmp = stack.enter_context(atomic_path(args.out))
+            fps = source.fps if source.fps > 0 else 15.0
+            writer = cv2.VideoWriter(
+                str(tmp), cv2.VideoWriter_fourcc(*"mp4v"), fps, (source.width, source.height)
+            )
+            if not writer.isOpened():
+                raise UserError(f"{args.out}: OpenCV cannot write a video there")
+            stack.callback(writer.release)
+        if args.csv is not None:
+            tmp = stack.enter_context(atomic_path(args.csv))
+            handle = stack.enter_context(open(tmp, "w", newline=""))
+            csv_writer = csv.writer(handle)
+            csv_writer.writerow(AUTHORS_COLUMNS + OUR_COLUMNS)
+        if args.rrd is not None:
+            from monopic.recording import RunRecording
+
+            recording = RunRecording(args.rrd)
+        try:
+            last = time.perf_counter()
+            fps_now = 0.0
+            bar = tqdm(source, total=source.frame_count, unit="frame", desc=Path(args.input).name)
+            for frame in bar:
+                result = pipeline.process(frame)
+                frames += 1
+                found += result.pose.found
+                now = time.perf_counter()
+                fps_now = 1.0 / max(now - last, 1e-6)
+                last = now
+                if writer is not None:
+                    annotated = draw(frame.image, result, variant, fps_now)
+                    writer.write(cv2.cvtColor(annotated, cv2.COLOR_RGB2BGR))
+                if csv_writer is not None and result.features is not None:
+                    csv_writer.writerow(_row(result, fps_now, args.horizon))
+                if recording is not None:
+                    recording.log_frame(frame.image, result)
+        except BaseException:
+            if recording is not None:
+                recording.abort()
+            raise
+        if recording is not None:
+            recording.close()
+    print(f"{frames} frames, person found in {found} ({100 * found / max(frames, 1):.0f} %)")
+    for label, path in (("video", args.out), ("csv", args.csv), ("recording", args.rrd)):
+        if path is not None:
+            print(f"{label}: {path}")
+    return 0
+
+
+def _ego(args: argparse.Namespace, width: int, height: int) -> EgoState | None:
+    if args.fov is None and args.camera_height is None:
+        return None
+    if args.fov is None or args.camera_height is None:
+        raise UserError("camera geometry needs both --fov and --camera-height")
+    camera = CameraModel.from_fov(width, height, args.fov, args.camera_height, args.pitch)
+    return EgoState(camera=camera, speed=args.speed)
+
+
+def _row(r: FrameResult, fps: float, horizon: float) -> list:
+    f, p, w = r.features, r.prediction, r.warning
+    pose = r.pose.pose
+    ls, rs = pose.landmarks[LEFT_SHOULDER], pose.landmarks[RIGHT_SHOULDER]
+    g = f.ground
+    pg = p.ground if p is not None else None
+    ms = r.stage_ms
+    nan = float("nan")
+    return [
+        r.frame_index, 4, IMAGE_DEAD_ZONE_PX_S, horizon, f"{r.timestamp:.6f}", f"{fps:.3f}",
+        f"{f.center[0]:.2f}", f"{f.center[1]:.2f}", f"{ls[0]:.2f}", f"{ls[1]:.2f}",
+        f"{rs[0]:.2f}", f"{rs[1]:.2f}", f"{f.phi:.4f}", f"{f.vx:.4f}", f"{f.vy:.4f}",
+        f"{f.apparent_height / r.image_size[1]:.5f}",
+        f"{p.center[0]:.2f}" if p else "", f"{p.center[1]:.2f}" if p else "",
+        int(p.case) if p else "", p.case.label if p else "", f"{f.phi_raw:.4f}",
+        f"{f.foot[0]:.2f}", f"{f.foot[1]:.2f}",
+        f"{p.foot[0]:.2f}" if p else "", f"{p.foot[1]:.2f}" if p else "",
+        f"{f.apparent_height:.2f}", f"{pose.score:.4f}",
+        int(w.collision) if w else "", w.risk.value if w else "",
+        f"{g.position[0]:.3f}" if g else "", f"{g.position[1]:.3f}" if g else "",
+        f"{g.velocity[0]:.3f}" if g else "", f"{g.velocity[1]:.3f}" if g else "",
+        f"{pg[0]:.3f}" if pg else "", f"{pg[1]:.3f}" if pg else "",
+        r.pose.detector_runs, f"{ms.get('detect', nan):.3f}", f"{ms.get('landmarks', nan):.3f}",
+        f"{ms.get('features', nan):.3f}", f"{ms.get('predict', nan):.3f}",
+        f"{ms.get('warning', nan):.3f}", f"{ms.get('total', nan):.3f}",
+    ]  # fmt: skip

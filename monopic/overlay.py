@@ -1,0 +1,80 @@
+"""Annotated frames like the paper's demo figures, drawn with OpenCV.
+
+Top-left: frame rate, latency (ms) and phi, as in the paper. Skeleton with the shoulders
+highlighted, the robot's zone, the predicted point and path, the case, and the risk.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+from monopic.pipeline import FrameResult, Variant
+from monopic.pose.skeleton import CONNECTIONS, LEFT_SHOULDER, RIGHT_SHOULDER
+from monopic.variants.warning import Risk
+
+# BGR is OpenCV's order, but our frames are RGB: colours below are RGB.
+RISK_COLOURS = {Risk.GREEN: (40, 200, 60), Risk.YELLOW: (240, 200, 0), Risk.RED: (230, 30, 30)}
+SKELETON = (80, 220, 255)
+SHOULDERS = (255, 60, 200)
+PREDICTION = (255, 255, 255)
+
+
+def _pt(p) -> tuple[int, int]:
+    return int(round(float(p[0]))), int(round(float(p[1])))
+
+
+def _finite(p) -> bool:
+    return bool(np.all(np.isfinite(np.asarray(p, dtype=float))))
+
+
+def draw(image: np.ndarray, result: FrameResult, variant: Variant, fps: float) -> np.ndarray:
+    """A copy of the RGB frame with the pipeline's outputs drawn on it."""
+    out = image.copy()
+    scale = max(out.shape[0] / 432, 0.5)
+    thick = max(1, int(round(2 * scale)))
+    w = result.warning
+    if w is not None and variant in (Variant.WARNING, Variant.PATH):
+        colour = RISK_COLOURS[w.risk]
+        zone = np.round(w.zone).astype(np.int32)
+        overlay = out.copy()
+        cv2.fillPoly(overlay, [zone], colour)
+        out = cv2.addWeighted(overlay, 0.18, out, 0.82, 0)
+        cv2.polylines(out, [zone], True, colour, thick, cv2.LINE_AA)
+    pose = result.pose.pose
+    if pose is not None:
+        lm = pose.landmarks
+        for a, b in CONNECTIONS:
+            if pose.visibility[a] > 0.3 and pose.visibility[b] > 0.3:
+                cv2.line(out, _pt(lm[a]), _pt(lm[b]), SKELETON, thick, cv2.LINE_AA)
+        for i in (LEFT_SHOULDER, RIGHT_SHOULDER):
+            cv2.circle(out, _pt(lm[i]), 3 * thick, SHOULDERS, -1, cv2.LINE_AA)
+        cv2.line(out, _pt(lm[LEFT_SHOULDER]), _pt(lm[RIGHT_SHOULDER]), SHOULDERS, thick)
+    f, p = result.features, result.prediction
+    if f is not None and p is not None and _finite(p.center):
+        if variant is Variant.PATH and result.path is not None:
+            path = result.path.image_path[np.all(np.isfinite(result.path.image_path), axis=1)]
+            cv2.polylines(out, [np.round(path).astype(np.int32)], False, PREDICTION, thick)
+            if result.path.conflict is not None:
+                cv2.drawMarker(
+                    out, _pt(result.path.conflict), RISK_COLOURS[Risk.RED],
+                    cv2.MARKER_TILTED_CROSS, int(18 * scale), thick + 1,
+                )  # fmt: skip
+        else:
+            cv2.arrowedLine(
+                out, _pt(f.center), _pt(p.center), PREDICTION, thick, cv2.LINE_AA, tipLength=0.2
+            )
+        cv2.circle(out, _pt(p.center), 5 * thick, PREDICTION, thick, cv2.LINE_AA)
+        label = f"case {int(p.case)}: {p.case.label}"
+        _text(out, label, (_pt(f.center)[0] - 60, max(int(40 * scale), _pt(f.center)[1] - 10)))
+    phi = f.phi if f is not None else float("nan")
+    _text(out, f"{fps:5.1f}  {result.stage_ms.get('total', 0.0):5.1f} ms  {phi:6.1f}", (8, 22))
+    if w is not None and w.collision and variant is Variant.WARNING:
+        _text(out, "COLLISION IMMINENT", (8, int(50 * scale)), RISK_COLOURS[Risk.RED], 1.0)
+    return out
+
+
+def _text(img, text, org, colour=(255, 255, 255), size: float = 0.6) -> None:
+    scale = max(img.shape[0] / 432, 0.5) * size
+    cv2.putText(img, text, org, cv2.FONT_HERSHEY_SIMPLEX, scale, (0, 0, 0), 4, cv2.LINE_AA)
+    cv2.putText(img, text, org, cv2.FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv2.LINE_AA)
