@@ -26,3 +26,9 @@ def atomic_path(path: Path) -> Iterator[Path]:
     if not tmp.exists():
         raise RuntimeError(f"nothing was written to {path}")
     os.replace(tmp, path)
+
+
+def write_text_atomically(path: Path, text: str) -> None:
+    """Write a whole text file under a temporary name, then rename it into place."""
+    with atomic_path(Path(path)) as tmp:
+        tmp.write_text(text, encoding="utf-8", newline="")

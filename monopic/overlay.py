@@ -76,5 +76,7 @@ def draw(image: np.ndarray, result: FrameResult, variant: Variant, fps: float) -
 
 def _text(img, text, org, colour=(255, 255, 255), size: float = 0.6) -> None:
     scale = max(img.shape[0] / 432, 0.5) * size
-    cv2.putText(img, text, org, cv2.FONT_HERSHEY_SIMPLEX, scale, (0, 0, 0), 4, cv2.LINE_AA)
-    cv2.putText(img, text, org, cv2.FONT_HERSHEY_SIMPLEX, scale, colour, 1, cv2.LINE_AA)
+    thick = max(1, round(2 * scale))
+    font = cv2.FONT_HERSHEY_SIMPLEX
+    cv2.putText(img, text, org, font, scale, (0, 0, 0), thick + 2, cv2.LINE_AA)
+    cv2.putText(img, text, org, font, scale, colour, thick, cv2.LINE_AA)

@@ -22,6 +22,7 @@ import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from monopic.output import temporary_sibling
 from monopic.pipeline import FrameResult
 from monopic.pose.skeleton import CONNECTIONS, LANDMARK_NAMES
 
@@ -55,7 +56,7 @@ class RunRecording:
         self, path: Path, application_id: str = "monopic", recording_id: str | None = None
     ):
         self.path = Path(path)
-        self.tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
+        self.tmp = temporary_sibling(self.path)
         self.rec = rr.RecordingStream(application_id, recording_id=recording_id)
         self.rec.save(str(self.tmp), default_blueprint=blueprint())
         self.rec.log(

@@ -7,11 +7,12 @@ from pathlib import Path
 
 from monopic.cli.tree import add_training_options, training_options
 from monopic.errors import UserError
+from monopic.output import write_text_atomically
 from monopic.predict.base import Mode
 from monopic.replay.dataset import prepare
 from monopic.replay.logs import read_log
 from monopic.replay.run import format_report, predictions_csv, replay
-from monopic.tree.serialise import load_model, write_atomically
+from monopic.tree.serialise import load_model
 
 DESCRIPTION = """\
 Replay logs in the authors' CSV format through our velocity estimate, tree and
@@ -60,7 +61,7 @@ def _replay(args: argparse.Namespace) -> int:
     except ValueError as err:
         raise UserError(str(err)) from err
     if out is not None:
-        write_atomically(out, predictions_csv(results))
+        write_text_atomically(out, predictions_csv(results))
     print(format_report(results), end="")
     if out is not None:
         print(f"predictions written to {out}")

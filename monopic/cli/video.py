@@ -22,6 +22,7 @@ from monopic.pose.skeleton import LEFT_SHOULDER, RIGHT_SHOULDER
 from monopic.pose.tracker import TrackerConfig
 from monopic.predict.base import Mode
 from monopic.predict.rules import IMAGE_DEAD_ZONE_PX_S
+from monopic.predictors import PREDICTOR_NAMES, make_predictor
 from monopic.video import VideoSource
 
 # The authors' log columns (their README), then ours.
@@ -48,6 +49,8 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--rrd", type=Path, help="rerun recording to write")
     p.add_argument("--horizon", type=positive_float, default=1.0, help="seconds ahead (1.0)")
     p.add_argument("--mode", choices=[m.value for m in Mode], default="image")
+    p.add_argument("--predictor", choices=PREDICTOR_NAMES, default="rules")
+    p.add_argument("--tree", type=Path, help="tree file for --predictor tree (default: shipped)")
     p.add_argument("--threads", type=positive_int, default=1, help="onnxruntime threads")
     g = p.add_argument_group("camera geometry (needed for ground mode and the projected zone)")
     g.add_argument("--fov", type=positive_float, help="vertical field of view, degrees")
@@ -69,8 +72,12 @@ def run(args: argparse.Namespace) -> int:
     for out in (args.out, args.csv, args.rrd):
         if out is not None and not out.parent.is_dir():
             raise UserError(f"{out}: its folder {out.parent} does not exist")
+    predictor = make_predictor(args.predictor, mode, args.tree)
     pipeline = Pipeline(
-        PipelineConfig(horizon=args.horizon, mode=mode, tracker=TrackerConfig(threads=args.threads))
+        PipelineConfig(
+            horizon=args.horizon, mode=mode, tracker=TrackerConfig(threads=args.threads)
+        ),
+        predictor,
     )
     variant = Variant(args.variant)
     found = frames = 0

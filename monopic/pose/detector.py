@@ -69,7 +69,7 @@ class PoseDetector:
             [self.regressor_name, self.score_name], {self.input_name: tensor[None]}
         )
         boxes = raw_boxes.reshape(-1, 12)
-        logits = np.clip(raw_scores.reshape(-1), -100.0, 100.0)
+        logits = np.clip(raw_scores.reshape(-1).astype(np.float64), -100.0, 100.0)
         scores = 1.0 / (1.0 + np.exp(-logits))
         keep = np.flatnonzero(scores >= self.min_score)
         out = []

@@ -8,14 +8,13 @@ with another format name or version is refused with a clear message rather than 
 from __future__ import annotations
 
 import json
-import os
-import tempfile
 from importlib import resources
 from pathlib import Path
 from typing import Any
 
 from monopic.cases import Case
 from monopic.errors import UserError
+from monopic.output import write_text_atomically
 from monopic.predict.base import Mode
 from monopic.tree.discretise import Discretiser
 from monopic.tree.id3 import DecisionTree
@@ -81,21 +80,8 @@ def dumps(model: TreeModel) -> str:
     return json.dumps(model_to_json(model), indent=1, allow_nan=False) + "\n"
 
 
-def write_atomically(path: Path, text: str) -> None:
-    """Write to a temporary file beside `path`, then rename: never a half-written file."""
-    path = Path(path)
-    fd, tmp = tempfile.mkstemp(dir=path.parent or Path("."), prefix=f".{path.name}.", suffix=".tmp")
-    try:
-        with os.fdopen(fd, "w", encoding="utf-8", newline="") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
-
-
 def save_model(model: TreeModel, path: Path) -> None:
-    write_atomically(Path(path), dumps(model))
+    write_text_atomically(Path(path), dumps(model))
 
 
 def load_model(path: Path) -> TreeModel:

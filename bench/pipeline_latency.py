@@ -1,0 +1,84 @@
+"""Per-stage latency of the pipeline on a 768x432 video, at 1 and 2 onnxruntime threads.
+
+Runs alternate between thread counts (A B A B ...) so machine noise hits both alike; the
+first pass over the clip of each is warm-up and not timed. Prints p50/p95 per stage and
+appends the table to BENCHMARKS.md.
+
+    .venv/bin/python bench/pipeline_latency.py [VIDEO] [--rounds 3]
+"""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+
+import numpy as np
+
+from monopic.pipeline import Pipeline, PipelineConfig
+from monopic.pose.tracker import TrackerConfig
+from monopic.video import VideoSource
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from common import append_section  # noqa: E402
+
+STAGES = ("detect", "landmarks", "pose", "features", "predict", "warning", "total")
+DEFAULT_VIDEO = Path(__file__).resolve().parents[1] / "tests" / "data" / "walk_clip.mp4"
+
+
+def run_once(frames, threads: int) -> dict[str, list[float]]:
+    pipeline = Pipeline(PipelineConfig(tracker=TrackerConfig(threads=threads)))
+    times: dict[str, list[float]] = {s: [] for s in STAGES}
+    for frame in frames:
+        r = pipeline.process(frame)
+        for s in STAGES:
+            if s in r.stage_ms:
+                times[s].append(r.stage_ms[s])
+    return times
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("video", nargs="?", type=Path, default=DEFAULT_VIDEO)
+    ap.add_argument("--rounds", type=int, default=3)
+    args = ap.parse_args()
+    frames = list(VideoSource(str(args.video)))
+    h, w = frames[0].image.shape[:2]
+    for threads in (1, 2):  # warm-up
+        run_once(frames, threads)
+    results: dict[int, dict[str, list[float]]] = {
+        1: {s: [] for s in STAGES},
+        2: {s: [] for s in STAGES},
+    }
+    for _ in range(args.rounds):
+        for threads in (1, 2):
+            for s, v in run_once(frames, threads).items():
+                results[threads][s].extend(v)
+    lines = [
+        f"{len(frames)} frames of {args.video.name} ({w}x{h}), "
+        f"{args.rounds} rounds per thread count",
+        "",
+        "| stage | 1 thread p50 | p95 | 2 threads p50 | p95 | ratio p50 (1/2) |",
+        "| --- | --- | --- | --- | --- | --- |",
+    ]
+    for s in STAGES:
+        a, b = np.array(results[1][s]), np.array(results[2][s])
+        if a.size == 0 or b.size == 0:
+            continue
+        p = [np.percentile(a, 50), np.percentile(a, 95), np.percentile(b, 50), np.percentile(b, 95)]
+        ratio = p[0] / p[2] if p[2] > 0 else float("nan")
+        lines.append(
+            f"| {s} | {p[0]:.2f} ms | {p[1]:.2f} ms | {p[2]:.2f} ms | {p[3]:.2f} ms | {ratio:.2f} |"
+        )
+    table = "\n".join(lines)
+    print(table)
+    append_section(
+        "Pipeline latency per stage",
+        f".venv/bin/python bench/pipeline_latency.py {args.video.name} --rounds {args.rounds}",
+        table + "\n\n`detect` counts only frames where the tracker (re)acquires; "
+        "`pose` = detect + crop + landmarks.",
+    )
+
+
+if __name__ == "__main__":
+    main()
