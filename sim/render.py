@@ -1,0 +1,166 @@
+"""Offscreen rendering of the robot camera, headless through EGL.
+
+The GL backend is the one MUJOCO_GL names, egl by default (set here and in sim/__init__
+before mujoco is imported; a value already in the environment wins). The renderer makes
+its own context for that backend instead of relying on the one mujoco picked when it
+was first imported. EGL contexts do not survive fork: create renderers inside each
+worker process (spawn).
+"""
+
+from __future__ import annotations
+
+import os
+
+os.environ.setdefault("MUJOCO_GL", "egl")
+
+from dataclasses import dataclass  # noqa: E402
+from types import TracebackType  # noqa: E402
+from typing import Any  # noqa: E402
+
+import mujoco  # noqa: E402
+import numpy as np  # noqa: E402
+
+from sim.scene import Scene  # noqa: E402
+
+GLContext = Any  # mujoco's egl/osmesa/glfw GLContext classes share no base class
+
+GL_PACKAGES = ("libegl1", "libgl1-mesa-dri", "libegl-mesa0")
+
+
+class GLUnavailableError(RuntimeError):
+    """No OpenGL context could be made for offscreen rendering."""
+
+
+@dataclass(frozen=True)
+class Marker:
+    """A sphere drawn on top of the scene for one render (tests, debugging)."""
+
+    position: tuple[float, float, float]  # world frame, m
+    radius: float = 0.03
+    rgba: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 1.0)
+    emissive: bool = True  # unlit, flat colour: easy to find in the image
+
+
+def _gl_context(width: int, height: int) -> GLContext:
+    """An offscreen OpenGL context for the backend MUJOCO_GL names (egl by default).
+
+    Chosen here, at construction, rather than by mujoco at import time, so rendering
+    works whatever imported mujoco first.
+    """
+    backend = os.environ.get("MUJOCO_GL", "egl").strip().lower()
+    if backend == "egl":
+        from mujoco.egl import GLContext as Context
+    elif backend == "osmesa":
+        from mujoco.osmesa import GLContext as Context
+    else:
+        from mujoco.glfw import GLContext as Context
+    return Context(width, height)
+
+
+class SceneRenderer:
+    """Renders the robot camera of a Scene at the camera model's image size."""
+
+    def __init__(self, scene: Scene, max_geom: int = 2000) -> None:
+        self.scene = scene
+        cam = scene.camera
+        self.width, self.height = cam.width, cam.height
+        model = scene.model
+        try:
+            self._context = _gl_context(self.width, self.height)
+            self._context.make_current()
+            self._mjr = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_100)
+        except Exception as err:  # ImportError, OSError, RuntimeError, mujoco.FatalError
+            backend = os.environ.get("MUJOCO_GL", "egl")
+            raise GLUnavailableError(
+                f"cannot create an offscreen OpenGL context (MUJOCO_GL={backend!r}): {err}. "
+                f"Install the EGL/Mesa packages: apt-get install {' '.join(GL_PACKAGES)}"
+            ) from err
+        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._mjr)
+        self._scene = mujoco.MjvScene(model, maxgeom=max_geom)
+        self._rect = mujoco.MjrRect(0, 0, self.width, self.height)
+        self._camera = mujoco.MjvCamera()
+        self._camera.type = mujoco.mjtCamera.mjCAMERA_FIXED
+        self._camera.fixedcamid = scene.camera_id
+        self._perturb = mujoco.MjvPerturb()
+        self._option = mujoco.MjvOption()
+        self._option.geomgroup[:] = [1, 1, 1, 0, 0, 0]  # hide the robot's own body
+        self._option.sitegroup[:] = [0] * len(self._option.sitegroup)
+        self._rgb = np.empty((self.height, self.width, 3), dtype=np.uint8)
+
+    def _draw(self, markers: tuple[Marker, ...], segmentation: bool) -> np.ndarray:
+        if self._mjr is None:
+            raise RuntimeError("render called after close")
+        self._context.make_current()
+        mujoco.mjv_updateScene(
+            self.scene.model,
+            self.scene.data,
+            self._option,
+            self._perturb,
+            self._camera,
+            mujoco.mjtCatBit.mjCAT_ALL,
+            self._scene,
+        )
+        for marker in markers:
+            _add_marker(self._scene, marker)
+        self._scene.flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = segmentation
+        self._scene.flags[mujoco.mjtRndFlag.mjRND_IDCOLOR] = segmentation
+        mujoco.mjr_render(self._rect, self._scene, self._mjr)
+        mujoco.mjr_readPixels(self._rgb, None, self._rect, self._mjr)
+        return np.flipud(self._rgb)  # OpenGL rows run bottom-up
+
+    def render(self, markers: tuple[Marker, ...] = ()) -> np.ndarray:
+        """The current robot-camera image, RGB uint8 (height, width, 3)."""
+        return self._draw(markers, segmentation=False).copy()
+
+    def pedestrian_mask(self) -> np.ndarray:
+        """Boolean (height, width) mask of the pixels where the pedestrian is visible.
+
+        Uses MuJoCo's segmentation rendering (each drawn geom in its own colour), so
+        occluders hide the pedestrian as they do in the colour image.
+        """
+        image = self._draw((), segmentation=True).astype(np.int64)
+        segid = image[..., 0] + (image[..., 1] << 8) + (image[..., 2] << 16)  # 0: none
+        lookup = np.zeros(self._scene.ngeom + 1, dtype=bool)
+        pedestrian = set(self.scene.mannequin.geom_ids.tolist())
+        for k in range(self._scene.ngeom):
+            g = self._scene.geoms[k]
+            if g.segid >= 0 and g.objtype == mujoco.mjtObj.mjOBJ_GEOM and g.objid in pedestrian:
+                lookup[g.segid + 1] = True
+        return lookup[np.clip(segid, 0, self._scene.ngeom)]
+
+    def close(self) -> None:
+        """Free the GL resources; the renderer cannot be used afterwards."""
+        if self._mjr is not None:
+            self._mjr.free()
+            self._mjr = None
+            self._context.free()
+
+    def __enter__(self) -> SceneRenderer:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+
+def _add_marker(scene: mujoco.MjvScene, marker: Marker) -> None:
+    if scene.ngeom >= scene.maxgeom:
+        raise RuntimeError("no room left in the MuJoCo scene for another marker")
+    geom = scene.geoms[scene.ngeom]
+    mujoco.mjv_initGeom(
+        geom,
+        type=mujoco.mjtGeom.mjGEOM_SPHERE,
+        size=np.array([marker.radius, 0.0, 0.0]),
+        pos=np.asarray(marker.position, dtype=float),
+        mat=np.eye(3).reshape(-1),
+        rgba=np.asarray(marker.rgba, dtype=np.float32),
+    )
+    if marker.emissive:
+        geom.emission = 1.0
+        geom.specular = 0.0
+    geom.category = int(mujoco.mjtCatBit.mjCAT_DECOR)
+    scene.ngeom += 1

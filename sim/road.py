@@ -1,0 +1,343 @@
+"""The static street: road with markings, pavements, grass, buildings, parked cars.
+
+The road runs along world x (east), centred on y = `center_y`. Every walkable surface
+has its top at z = 0 so that the ground plane of monopic's camera model is exact; paint
+sits a few millimetres above the asphalt (as real paint does) so it never z-fights.
+Surfaces are thin boxes with procedural textures (asphalt grain, paving slabs, grass),
+markings are thin white boxes, all added to an MjSpec in code.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+
+from sim.frames import yaw_quat
+
+RGB = tuple[float, float, float]
+PAINT_HEIGHT = 0.004  # m, top of the road markings above the asphalt
+SLAB_DEPTH = 0.1  # m, thickness of the road and pavement boxes below z = 0
+
+
+@dataclass(frozen=True)
+class RoadLayout:
+    """Geometry of the street; lengths in metres."""
+
+    length: float = 240.0  # along x, centred on x = 0
+    lanes: int = 2
+    lane_width: float = 3.5
+    center_y: float = 0.0
+    pavement_width: float = 3.0
+    crosswalk_x: float | None = 12.0  # centre of the zebra crossing along x, None for none
+    crosswalk_length: float = 4.0  # extent of the crossing along x
+    stripe_width: float = 0.5  # zebra bar width (and gap) across the road
+    line_width: float = 0.12
+    dash_length: float = 3.0
+    dash_gap: float = 6.0
+    buildings: bool = True  # a row of facades behind each pavement
+
+    def __post_init__(self) -> None:
+        if self.lanes < 1 or self.lane_width <= 0 or self.length <= 0:
+            raise ValueError("road needs at least one lane of positive width and length")
+
+    @property
+    def half_width(self) -> float:
+        return self.lanes * self.lane_width / 2
+
+    @property
+    def edges(self) -> tuple[float, float]:
+        """y of the right (south) and left (north) road edges."""
+        return self.center_y - self.half_width, self.center_y + self.half_width
+
+
+@dataclass(frozen=True)
+class Occluder:
+    """A static box on the ground (e.g. a parked car): centre x, y, heading, size (m)."""
+
+    x: float
+    y: float
+    yaw: float = 0.0
+    length: float = 4.5
+    width: float = 1.8
+    height: float = 1.45
+    colour: RGB = (0.55, 0.1, 0.1)
+
+    @classmethod
+    def parked_car(
+        cls, x: float, y: float, yaw: float = 0.0, colour: RGB = (0.55, 0.1, 0.1)
+    ) -> Occluder:
+        """A family-car-sized box."""
+        return cls(x=x, y=y, yaw=yaw, colour=colour)
+
+
+def _texture(spec: mujoco.MjSpec, name: str, **kw: object) -> None:
+    spec.add_texture(name=name, type=mujoco.mjtTexture.mjTEXTURE_2D, width=512, height=512, **kw)
+
+
+def _material(
+    spec: mujoco.MjSpec,
+    name: str,
+    rgba: tuple[float, float, float, float],
+    texture: str | None = None,
+    texrepeat: tuple[float, float] = (1.0, 1.0),
+    specular: float = 0.05,
+    shininess: float = 0.05,
+) -> str:
+    mat = spec.add_material(name=name)
+    mat.rgba = list(rgba)
+    mat.specular = specular
+    mat.shininess = shininess
+    mat.reflectance = 0.0
+    if texture is not None:
+        textures = [""] * int(mujoco.mjtTextureRole.mjNTEXROLE)
+        textures[int(mujoco.mjtTextureRole.mjTEXROLE_RGB)] = texture
+        mat.textures = textures
+        mat.texuniform = True
+        mat.texrepeat = list(texrepeat)
+    return name
+
+
+def _box(
+    spec: mujoco.MjSpec,
+    name: str,
+    centre: tuple[float, float, float],
+    half: tuple[float, float, float],
+    material: str,
+    yaw: float = 0.0,
+) -> None:
+    spec.worldbody.add_geom(
+        name=name,
+        type=mujoco.mjtGeom.mjGEOM_BOX,
+        pos=list(centre),
+        size=list(half),
+        quat=yaw_quat(yaw).tolist(),
+        material=material,
+        contype=0,
+        conaffinity=0,
+        group=0,
+    )
+
+
+def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occluder, ...]) -> None:
+    """Add ground, road, markings, pavements, buildings and occluders to `spec`."""
+    _texture(
+        spec,
+        "asphalt",
+        builtin=mujoco.mjtBuiltin.mjBUILTIN_FLAT,
+        mark=mujoco.mjtMark.mjMARK_RANDOM,
+        random=0.25,
+        rgb1=[0.25, 0.25, 0.26],
+        markrgb=[0.36, 0.36, 0.36],
+    )
+    _texture(
+        spec,
+        "slabs",
+        builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
+        mark=mujoco.mjtMark.mjMARK_EDGE,
+        rgb1=[0.66, 0.64, 0.6],
+        rgb2=[0.6, 0.58, 0.55],
+        markrgb=[0.45, 0.44, 0.42],
+    )
+    _texture(
+        spec,
+        "grass",
+        builtin=mujoco.mjtBuiltin.mjBUILTIN_FLAT,
+        mark=mujoco.mjtMark.mjMARK_RANDOM,
+        random=0.4,
+        rgb1=[0.27, 0.42, 0.2],
+        markrgb=[0.35, 0.5, 0.25],
+    )
+    asphalt = _material(spec, "asphalt", (1, 1, 1, 1), "asphalt", (0.5, 0.5))
+    slabs = _material(spec, "slabs", (1, 1, 1, 1), "slabs", (0.5, 0.5))
+    grass = _material(spec, "grass", (1, 1, 1, 1), "grass", (0.2, 0.2))
+    paint = _material(spec, "paint", (0.92, 0.92, 0.9, 1), specular=0.1)
+    kerb = _material(spec, "kerb", (0.72, 0.71, 0.68, 1))
+
+    extent = road.length * 1.5
+    spec.worldbody.add_geom(
+        name="ground",
+        type=mujoco.mjtGeom.mjGEOM_PLANE,
+        pos=[0, road.center_y, -0.01],
+        size=[extent, extent, 1.0],
+        material=grass,
+        contype=0,
+        conaffinity=0,
+        group=0,
+    )
+    half_len = road.length / 2
+    y_right, y_left = road.edges
+    _box(
+        spec,
+        "road",
+        (0, road.center_y, -SLAB_DEPTH / 2),
+        (half_len, road.half_width, SLAB_DEPTH / 2),
+        asphalt,
+    )
+    for name, sign, edge in (("south", -1.0, y_right), ("north", 1.0, y_left)):
+        kerb_w = 0.15
+        _box(
+            spec,
+            f"kerb_{name}",
+            (0, edge + sign * kerb_w / 2, -SLAB_DEPTH / 2),
+            (half_len, kerb_w / 2, SLAB_DEPTH / 2),
+            kerb,
+        )
+        pav_centre = edge + sign * (kerb_w + road.pavement_width / 2)
+        _box(
+            spec,
+            f"pavement_{name}",
+            (0, pav_centre, -SLAB_DEPTH / 2),
+            (half_len, road.pavement_width / 2, SLAB_DEPTH / 2),
+            slabs,
+        )
+
+    paint_half_h = PAINT_HEIGHT / 2
+    lw = road.line_width / 2
+    # Solid edge lines.
+    for name, y in (("south", y_right + 0.25), ("north", y_left - 0.25)):
+        _box(spec, f"edge_line_{name}", (0, y, paint_half_h), (half_len, lw, paint_half_h), paint)
+    # Dashed separators between lanes, with a gap across the zebra crossing.
+    period = road.dash_length + road.dash_gap
+    starts = np.arange(-half_len, half_len - road.dash_length, period)
+    for lane in range(1, road.lanes):
+        y = y_right + lane * road.lane_width
+        for k, x0 in enumerate(starts):
+            xc = x0 + road.dash_length / 2
+            if road.crosswalk_x is not None and abs(xc - road.crosswalk_x) < (
+                road.crosswalk_length / 2 + road.dash_length
+            ):
+                continue
+            _box(
+                spec,
+                f"dash_{lane}_{k}",
+                (xc, y, paint_half_h),
+                (road.dash_length / 2, lw, paint_half_h),
+                paint,
+            )
+    # Zebra crossing: bars parallel to the traffic, spaced across the road.
+    if road.crosswalk_x is not None:
+        n_bars = int((2 * road.half_width - 0.5) // (2 * road.stripe_width))
+        span = n_bars * 2 * road.stripe_width - road.stripe_width
+        y0 = road.center_y - span / 2 + road.stripe_width / 2
+        for k in range(n_bars):
+            _box(
+                spec,
+                f"zebra_{k}",
+                (road.crosswalk_x, y0 + 2 * k * road.stripe_width, paint_half_h),
+                (road.crosswalk_length / 2, road.stripe_width / 2, paint_half_h),
+                paint,
+            )
+
+    if road.buildings:
+        _add_buildings(spec, road)
+    for k, occ in enumerate(occluders):
+        _add_occluder(spec, k, occ)
+
+
+def _facade_texture(spec: mujoco.MjSpec, name: str, wall: RGB) -> None:
+    """One window bay (2.5 m wide, 3 m high) of a facade; the material tiles it."""
+    size = 128
+    img = np.empty((size, size, 3), dtype=np.uint8)
+    img[:] = np.round(np.array(wall) * 255).astype(np.uint8)
+    glass = np.array([58, 68, 88], dtype=np.uint8)
+    frame = np.round(np.array(wall) * 255 * 0.8).astype(np.uint8)
+    img[22:86, 30:98] = frame
+    img[26:82, 34:94] = glass
+    img[52:56, 34:94] = frame  # transom
+    tex = spec.add_texture(
+        name=name, type=mujoco.mjtTexture.mjTEXTURE_2D, width=size, height=size, nchannel=3
+    )
+    tex.data = img.tobytes()
+
+
+def _add_buildings(spec: mujoco.MjSpec, road: RoadLayout) -> None:
+    """Facades along both pavements: one textured box per building, deterministic sizes."""
+    colours: list[RGB] = [
+        (0.76, 0.7, 0.6),
+        (0.62, 0.45, 0.38),
+        (0.82, 0.8, 0.74),
+        (0.55, 0.57, 0.6),
+        (0.7, 0.6, 0.45),
+    ]
+    mats = []
+    for i, c in enumerate(colours):
+        _facade_texture(spec, f"facade_{i}", c)
+        mats.append(_material(spec, f"facade_{i}", (1, 1, 1, 1), f"facade_{i}", (0.4, 1 / 3)))
+    y_right, y_left = road.edges
+    setback = 0.15 + road.pavement_width + 1.0
+    half_len = road.length / 2
+    for side, sign, edge in (("south", -1.0, y_right), ("north", 1.0, y_left)):
+        x = -half_len
+        k = 0
+        while x < half_len:
+            width = 10.0 + 5.0 * ((k * 7 + (3 if sign > 0 else 0)) % 4)
+            height = 6.0 + 3.0 * ((k * 5 + (1 if sign > 0 else 2)) % 5)
+            depth = 8.0
+            _box(
+                spec,
+                f"building_{side}_{k}",
+                (x + width / 2, edge + sign * (setback + depth / 2), height / 2),
+                (width / 2 - 0.3, depth / 2, height / 2),
+                mats[(k + (2 if sign > 0 else 0)) % len(mats)],
+            )
+            x += width
+            k += 1
+
+
+def _add_occluder(spec: mujoco.MjSpec, k: int, occ: Occluder) -> None:
+    """A car-like occluder: a body box and a narrower cabin box on top."""
+    body_mat = _material(spec, f"occluder_{k}", (*occ.colour, 1.0), specular=0.4, shininess=0.5)
+    glass = _material(
+        spec, f"occluder_{k}_glass", (0.15, 0.18, 0.22, 1.0), specular=0.6, shininess=0.8
+    )
+    lower = 0.55 * occ.height
+    clearance = 0.18
+    _box(
+        spec,
+        f"occluder_{k}_body",
+        (occ.x, occ.y, clearance + (lower - clearance) / 2),
+        (occ.length / 2, occ.width / 2, (lower - clearance) / 2),
+        body_mat,
+        occ.yaw,
+    )
+    cab_len = 0.55 * occ.length
+    back = -0.08 * occ.length
+    cx = occ.x + math.cos(occ.yaw) * back
+    cy = occ.y + math.sin(occ.yaw) * back
+    _box(
+        spec,
+        f"occluder_{k}_cabin",
+        (cx, cy, lower + (occ.height - lower) / 2),
+        (cab_len / 2, occ.width / 2 - 0.08, (occ.height - lower) / 2),
+        glass,
+        occ.yaw,
+    )
+    # Wheels hint at a car from low camera heights and fill the gap under the body.
+    for j, (fx, fy) in enumerate(((0.33, 0.47), (0.33, -0.47), (-0.33, 0.47), (-0.33, -0.47))):
+        dx, dy = fx * occ.length, fy * occ.width
+        wx = occ.x + math.cos(occ.yaw) * dx - math.sin(occ.yaw) * dy
+        wy = occ.y + math.sin(occ.yaw) * dx + math.cos(occ.yaw) * dy
+        spec.worldbody.add_geom(
+            name=f"occluder_{k}_wheel_{j}",
+            type=mujoco.mjtGeom.mjGEOM_CYLINDER,
+            pos=[wx, wy, 0.32],
+            size=[0.32, 0.11, 0],
+            quat=_wheel_quat(occ.yaw).tolist(),
+            rgba=[0.08, 0.08, 0.08, 1],
+            contype=0,
+            conaffinity=0,
+            group=0,
+        )
+
+
+def _wheel_quat(yaw: float) -> np.ndarray:
+    """Orientation of a wheel cylinder: axis along the car's lateral direction."""
+    # Cylinder axis is local z; turn it to the car's y axis: yaw, then 90 deg about x.
+    qz = yaw_quat(yaw)
+    qx = np.array([math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0])
+    out = np.zeros(4)
+    mujoco.mju_mulQuat(out, qz, qx)
+    return out

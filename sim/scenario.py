@@ -1,0 +1,120 @@
+"""What a scenario is: the robot, its camera, the pedestrian's path, the scene, the horizon.
+
+A scenario fully determines a run (with its seed). It is plain data: scenario files
+(scenarios/*.toml) load into it, the eight-case placement builds it from a few
+parameters, and World consumes it. Positions are in the simulator's world frame
+(sim.frames: x east, y north, z up; headings in degrees counter-clockwise from east).
+The robot starts at the origin heading east along the road's lane.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+from monopic.camera import CameraModel
+from monopic.cases import Case
+from sim.mannequin import MannequinSpec
+from sim.road import Occluder, RoadLayout
+
+
+@dataclass(frozen=True)
+class CameraSpec:
+    """The robot's forward camera."""
+
+    width: int = 768
+    height: int = 432
+    vertical_fov_deg: float = 65.0
+    mount_height: float = 1.2  # m above the ground
+    pitch_deg: float = 5.0  # positive looks down
+    mount_forward: float = 0.0  # m ahead of the robot's reference point
+
+    def model(self) -> CameraModel:
+        return CameraModel.from_fov(
+            self.width,
+            self.height,
+            self.vertical_fov_deg,
+            self.mount_height,
+            self.pitch_deg,
+            self.mount_forward,
+        )
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """The camera-carrying robot: a highway-env vehicle of this size and speed."""
+
+    speed: float = 2.0  # m/s at the start (0: standing robot)
+    width: float = 0.6  # m
+    length: float = 0.8  # m
+    camera: CameraSpec = field(default_factory=CameraSpec)
+    # Limits of the longitudinal action (m/s^2) and of the speed (m/s); it never reverses.
+    max_acceleration: float = 3.0
+    max_deceleration: float = 8.0  # braking, as a positive number
+    max_speed: float = 20.0
+
+
+@dataclass(frozen=True)
+class Leg:
+    """One piece of the pedestrian's path after the start.
+
+    From `at` seconds after the start, walk at `speed` (0: stand still) with the heading
+    turned by `turn_deg` (counter-clockwise) relative to the previous leg.
+    """
+
+    at: float
+    speed: float
+    turn_deg: float = 0.0
+
+
+@dataclass(frozen=True)
+class PedestrianSpec:
+    """The mannequin (stature, clothing) and its path: start, heading, speed, then legs."""
+
+    x: float
+    y: float
+    heading_deg: float
+    speed: float  # m/s, 0 for standing
+    looks: MannequinSpec = field(default_factory=MannequinSpec.adult)
+    legs: tuple[Leg, ...] = ()
+    start_delay: float = 0.0  # s standing at the start before walking
+    footprint: float = 0.5  # m, side of the square the pedestrian occupies on the ground
+
+    def heading_at(self, t: float) -> float:
+        """Heading in radians at time t (turns of the legs started so far)."""
+        turn = sum(leg.turn_deg for leg in self.legs if leg.at <= t)
+        return math.radians(self.heading_deg + turn)
+
+
+@dataclass(frozen=True)
+class SceneSpec:
+    occluders: tuple[Occluder, ...] = ()  # e.g. Occluder.parked_car(x, y)
+    road: RoadLayout = field(default_factory=RoadLayout)
+    sun_azimuth_deg: float = 210.0
+    sun_elevation_deg: float = 50.0
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """One run's complete description."""
+
+    name: str
+    pedestrian: PedestrianSpec
+    robot: RobotSpec = field(default_factory=RobotSpec)
+    scene: SceneSpec = field(default_factory=SceneSpec)
+    family: str = ""
+    case: Case | None = None  # the case the scenario is built to show, if any
+    duration: float = 4.0  # s
+    dt: float = 1.0 / 15.0  # s per frame (15 fps like the paper's data)
+    horizon: float = 1.0  # s, the warning horizon
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        for name in ("duration", "dt", "horizon"):
+            value = getattr(self, name)
+            if not (math.isfinite(value) and value > 0):
+                raise ValueError(f"scenario {self.name!r}: {name} must be positive, got {value}")
+
+    @property
+    def frames(self) -> int:
+        return int(round(self.duration / self.dt))
