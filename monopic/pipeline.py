@@ -6,6 +6,7 @@ pedestrian. One instance per stream (it keeps the track's state).
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 
@@ -41,31 +42,86 @@ class PipelineConfig:
 
 
 @dataclass(frozen=True)
+class Decision:
+    """One predictor's verdict on a frame: prediction, warning and projected path."""
+
+    predictor: str  # "name/mode", e.g. "rules/image"
+    mode: Mode
+    prediction: Prediction
+    warning: Warning
+    path: PathProjection
+
+
+@dataclass(frozen=True)
 class FrameResult:
-    """Everything the pipeline produced for one frame (pose may be absent)."""
+    """Everything the pipeline produced for one frame (pose may be absent).
+
+    `decisions` holds one entry per predictor that could decide (ground-mode predictors
+    need the camera model and a foot point below the horizon); the first predictor is
+    the primary one, exposed as `prediction`, `warning` and `path`.
+    """
 
     frame_index: int
     timestamp: float
     pose: PoseResult
     features: Features | None
-    prediction: Prediction | None
-    warning: Warning | None
-    path: PathProjection | None
+    decisions: tuple[Decision, ...]
     stage_ms: dict[str, float]
     image_size: tuple[int, int]
+    primary: str = ""
+
+    def decision(self, key: str) -> Decision | None:
+        return next((d for d in self.decisions if d.predictor == key), None)
+
+    @property
+    def prediction(self) -> Prediction | None:
+        d = self.decision(self.primary)
+        return d.prediction if d else None
+
+    @property
+    def warning(self) -> Warning | None:
+        d = self.decision(self.primary)
+        return d.warning if d else None
+
+    @property
+    def path(self) -> PathProjection | None:
+        d = self.decision(self.primary)
+        return d.path if d else None
+
+
+def predictor_key(predictor: Predictor) -> str:
+    return f"{predictor.name}/{predictor.mode}"
 
 
 class Pipeline:
-    def __init__(self, config: PipelineConfig | None = None, predictor: Predictor | None = None):
+    """Pose and features once per frame, then every predictor side by side.
+
+    Running several predictors (and both modes) on the same pose is how sweeps compare
+    them fairly: the expensive stage is shared, the decisions differ only by the method.
+    """
+
+    def __init__(
+        self,
+        config: PipelineConfig | None = None,
+        predictors: Predictor | Sequence[Predictor] | None = None,
+    ):
         self.config = config or PipelineConfig()
-        self.predictor = predictor or RulePredictor(mode=self.config.mode)
-        if self.predictor.mode is not self.config.mode:
-            raise ValueError(
-                f"predictor {self.predictor.name} works in {self.predictor.mode} mode, "
-                f"the pipeline in {self.config.mode} mode"
-            )
+        if predictors is None:
+            predictors = [RulePredictor(mode=self.config.mode)]
+        elif not isinstance(predictors, Sequence):
+            predictors = [predictors]
+        if not predictors:
+            raise ValueError("a pipeline needs at least one predictor")
+        self.predictors = list(predictors)
+        keys = [predictor_key(p) for p in self.predictors]
+        if len(set(keys)) != len(keys):
+            raise ValueError(f"predictors must differ by name or mode, got {keys}")
         self.tracker = PoseTracker(self.config.tracker)
         self.features = FeatureExtractor()
+
+    @property
+    def primary(self) -> str:
+        return predictor_key(self.predictors[0])
 
     def process(self, frame: Frame, region: Region | None = None) -> FrameResult:
         """Run every stage on one frame; `region` overrides detection (ablations only)."""
@@ -75,15 +131,20 @@ class Pipeline:
         timer.lap("pose")
         feats = self.features.update(frame.timestamp, pose.pose, h, frame.ego)
         timer.lap("features")
-        prediction = warning = path = None
-        if feats is not None and (self.config.mode is Mode.IMAGE or feats.ground is not None):
-            prediction = self.predictor.predict(feats, self.config.horizon)
+        decisions = []
+        for predictor in self.predictors if feats is not None else ():
+            if predictor.mode is Mode.GROUND and feats.ground is None:
+                continue
+            prediction = predictor.predict(feats, self.config.horizon)
             timer.lap("predict")
             warning = self.config.warning.assess(
-                feats, prediction, self.config.mode, (w, h), frame.ego
+                feats, prediction, predictor.mode, (w, h), frame.ego
             )
             path = project_path(feats, prediction, warning.zone)
             timer.lap("warning")
+            decisions.append(
+                Decision(predictor_key(predictor), predictor.mode, prediction, warning, path)
+            )
         stage_ms = dict(timer.laps)
         stage_ms["detect"] = pose.detect_ms
         stage_ms["landmarks"] = pose.landmark_ms
@@ -91,5 +152,6 @@ class Pipeline:
             stage_ms.get(k, 0.0) for k in ("pose", "features", "predict", "warning")
         )
         return FrameResult(
-            frame.index, frame.timestamp, pose, feats, prediction, warning, path, stage_ms, (w, h)
-        )
+            frame.index, frame.timestamp, pose, feats, tuple(decisions), stage_ms, (w, h),
+            self.primary,
+        )  # fmt: skip
