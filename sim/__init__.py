@@ -8,3 +8,4 @@ environment wins.
 import os
 
 os.environ.setdefault("MUJOCO_GL", "egl")
+import sim.env  # noqa: E402, F401  (registers monopic/PedestrianCrossing-v0)

@@ -59,7 +59,8 @@ class Leg:
     """One piece of the pedestrian's path after the start.
 
     From `at` seconds after the start, walk at `speed` (0: stand still) with the heading
-    turned by `turn_deg` (counter-clockwise) relative to the previous leg.
+    turned by `turn_deg` (counter-clockwise) relative to the previous leg. The start is
+    the scenario's t = 0 (start_delay does not shift legs; see sim.pedestrian).
     """
 
     at: float
@@ -89,9 +90,9 @@ class PedestrianSpec:
 @dataclass(frozen=True)
 class SceneSpec:
     occluders: tuple[Occluder, ...] = ()  # e.g. Occluder.parked_car(x, y)
-    road: RoadLayout = field(default_factory=RoadLayout)
     sun_azimuth_deg: float = 210.0
     sun_elevation_deg: float = 50.0
+    road: RoadLayout = field(default_factory=RoadLayout)  # the street (MuJoCo and highway-env)
 
 
 @dataclass(frozen=True)

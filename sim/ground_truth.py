@@ -1,0 +1,313 @@
+"""Ground truth per frame: what the simulator knows that the pipeline must find out.
+
+Assembled by World from highway-env's objects (robot, pedestrian path, footprints) and the
+posed MuJoCo mannequin (sim.truth.PedestrianTruth). Conventions:
+
+- world frame as in sim.frames; robot frame as in monopic.camera (x forward, y left),
+  taken at this frame's robot pose;
+- velocities are the pedestrian's own motion over the ground (not relative to the robot)
+  unless named `relative_`;
+- the case is monopic.cases.case_from_ground_velocity of the pedestrian's mean own
+  velocity over the next CASE_WINDOW seconds of its true path, in the robot's axes now;
+- collision: the robot keeps its course (constant speed and heading) while the pedestrian
+  follows its true path; both footprints are highway-env polygons (RoadObject.polygon)
+  and "meet" means highway-env's separating-axis test (utils.are_polygons_intersecting)
+  says they intersect. Between the path's breakpoints both move in straight lines, so
+  the first contact time follows exactly from the same axes (see `contact_window`);
+- occlusion: a MuJoCo ray from the camera to each landmark (mj_ray over the geoms the
+  camera draws): a landmark is hidden when something other than the mannequin is hit
+  first. `occluded` means more than half of the landmarks are hidden. This needs no
+  rendering, so it is available in ground-truth-only runs.
+- facing: `facing_yaw_view` is the pedestrian's heading relative to the line of sight
+  from the camera (0: back to the camera, +-pi: facing it, +pi/2: walking to the
+  camera's left); the shoulder line then leaves the image plane by
+  beta = asin(sin(facing_yaw_view)) and the paper's phi it implies is 2 * beta in
+  degrees (monopic/features/orientation.py): 0 square to the camera, +180 in left
+  profile, -180 in right profile.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import mujoco
+import numpy as np
+from highway_env import utils
+
+from monopic.camera import CameraModel
+from monopic.cases import Case, case_from_ground_velocity
+from sim.frames import Pose2D, wrap_angle
+from sim.pedestrian import Pedestrian
+from sim.truth import PedestrianTruth
+
+CASE_WINDOW = 1.0  # s of future motion that defines the ground-truth case
+OCCLUSION_TOLERANCE = 0.02  # m: a hit this close before the landmark does not hide it
+TORSO_LANDMARKS = (11, 12, 23, 24)  # shoulders and hips: their mean is the body centre
+VISIBLE_GEOM_GROUPS = np.array([1, 1, 1, 0, 0, 0], dtype=np.uint8)  # what the camera draws
+
+
+@dataclass(frozen=True)
+class RobotState:
+    """The robot's own state at one frame (what it knows about itself, plus its pose)."""
+
+    time: float
+    position: np.ndarray  # (2,) world x, y of the reference point
+    yaw: float  # rad, CCW from east
+    speed: float  # m/s
+    acceleration: float  # m/s^2 applied over the last step (after clipping)
+    yaw_rate: float  # rad/s
+    length: float
+    width: float
+
+    @property
+    def pose(self) -> Pose2D:
+        return Pose2D(float(self.position[0]), float(self.position[1]), self.yaw)
+
+    def to_dict(self) -> dict[str, object]:
+        return {
+            "time": self.time,
+            "x": float(self.position[0]),
+            "y": float(self.position[1]),
+            "yaw": self.yaw,
+            "speed": self.speed,
+            "acceleration": self.acceleration,
+            "yaw_rate": self.yaw_rate,
+            "length": self.length,
+            "width": self.width,
+        }
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    """Everything true about the pedestrian and the robot at one frame."""
+
+    time: float
+    index: int
+    robot: RobotState
+    # The pedestrian on its path (the footprint's centre), world frame.
+    position_world: np.ndarray  # (2,)
+    velocity_world: np.ndarray  # (2,)
+    heading_world: float  # rad, CCW from east
+    speed: float
+    # The same in the robot frame now (x forward, y left); velocity is own ground motion.
+    position_robot: np.ndarray  # (2,)
+    velocity_robot: np.ndarray  # (2,)
+    relative_velocity_robot: np.ndarray  # (2,) pedestrian minus robot velocity
+    heading_robot: float  # rad, relative to the robot's heading
+    # The next CASE_WINDOW seconds and the horizon.
+    case: Case
+    case_velocity_robot: np.ndarray  # (2,) mean own velocity over the case window
+    horizon: float
+    future_position_world: np.ndarray  # (2,) where the path is at time + horizon
+    future_position_robot: np.ndarray  # (2,) that point in the robot frame now
+    # Collision (footprints, robot keeping its course).
+    contact: bool  # footprints intersect now
+    collision: bool  # they meet within the horizon (contact now included)
+    time_to_collision: float | None  # s to the first contact, None if none in the lookahead
+    # Image.
+    body: PedestrianTruth  # landmarks world/robot/px, foot point, box, in_frame
+    centre_px: np.ndarray  # (2,) projection of the torso centre
+    landmarks_occluded: np.ndarray  # (33,) bool: line of sight blocked by another object
+    visible_fraction: float  # landmarks inside the image and not occluded
+    occluded: bool
+    # Facing.
+    facing_yaw: float  # rad, heading relative to the camera's optical axis
+    facing_yaw_view: float  # rad, heading relative to the line of sight
+    beta: float  # rad, shoulder line out of the image plane, in [-pi/2, pi/2]
+    phi: float  # deg, the paper's facing angle this implies (2 * beta)
+
+    @property
+    def landmarks_px(self) -> np.ndarray:
+        return self.body.landmarks_px
+
+    @property
+    def foot_px(self) -> np.ndarray:
+        return self.body.foot_px
+
+    @property
+    def box(self) -> tuple[float, float, float, float]:
+        return self.body.box
+
+    @property
+    def in_frame(self) -> bool:
+        return self.body.in_frame
+
+    @property
+    def apparent_height(self) -> float:
+        """True apparent height of the whole body in pixels (ignoring occlusion)."""
+        return self.body.box_height
+
+    def to_dict(self) -> dict[str, object]:
+        """Plain JSON-ready values (NaN as None), e.g. for gym infos and result lines."""
+        return {
+            "time": self.time,
+            "index": self.index,
+            "robot": self.robot.to_dict(),
+            "position_world": _plain(self.position_world),
+            "velocity_world": _plain(self.velocity_world),
+            "heading_world": self.heading_world,
+            "speed": self.speed,
+            "position_robot": _plain(self.position_robot),
+            "velocity_robot": _plain(self.velocity_robot),
+            "relative_velocity_robot": _plain(self.relative_velocity_robot),
+            "heading_robot": self.heading_robot,
+            "case": int(self.case),
+            "case_velocity_robot": _plain(self.case_velocity_robot),
+            "horizon": self.horizon,
+            "future_position_world": _plain(self.future_position_world),
+            "future_position_robot": _plain(self.future_position_robot),
+            "contact": self.contact,
+            "collision": self.collision,
+            "time_to_collision": self.time_to_collision,
+            "landmarks_px": _plain(self.body.landmarks_px),
+            "foot_px": _plain(self.body.foot_px),
+            "centre_px": _plain(self.centre_px),
+            "box": _plain(np.array(self.body.box)),
+            "in_frame": self.body.in_frame,
+            "apparent_height": _plain(np.array(self.apparent_height)),
+            "landmarks_occluded": [bool(v) for v in self.landmarks_occluded],
+            "visible_fraction": self.visible_fraction,
+            "occluded": self.occluded,
+            "facing_yaw": self.facing_yaw,
+            "facing_yaw_view": self.facing_yaw_view,
+            "beta": self.beta,
+            "phi": self.phi,
+        }
+
+
+def _plain(values: np.ndarray) -> object:
+    """Nested lists of floats with None for non-finite values."""
+    arr = np.asarray(values, dtype=float)
+    if arr.ndim == 0:
+        return float(arr) if math.isfinite(float(arr)) else None
+    return [_plain(v) for v in arr]
+
+
+def contact_window(
+    poly_a: np.ndarray,
+    vel_a: np.ndarray,
+    poly_b: np.ndarray,
+    vel_b: np.ndarray,
+    t_max: float,
+) -> tuple[float, float] | None:
+    """Times in [0, t_max] when two convex polygons moving at constant velocities overlap.
+
+    Polygons are closed point lists as RoadObject.polygon() returns them. This is
+    highway-env's separating-axis test (the edge normals of both polygons, projections by
+    utils.project_polygon, touching counts as intersecting) solved for time: along each
+    axis the projections overlap during one interval of t; the polygons overlap when all
+    axes do. None when they never overlap in [0, t_max].
+    """
+    lo, hi = 0.0, float(t_max)
+    rel = np.asarray(vel_a, dtype=float) - np.asarray(vel_b, dtype=float)
+    for polygon in (poly_a, poly_b):
+        for p1, p2 in zip(polygon, polygon[1:], strict=False):
+            normal = np.array([-p2[1] + p1[1], p2[0] - p1[0]])
+            normal /= np.linalg.norm(normal)
+            min_a, max_a = utils.project_polygon(poly_a, normal)
+            min_b, max_b = utils.project_polygon(poly_b, normal)
+            r = float(normal @ rel)
+            # Overlap on this axis: min_b - max_a <= r t <= max_b - min_a.
+            if abs(r) < 1e-12:
+                if min_b - max_a > 0 or max_b - min_a < 0:
+                    return None
+                continue
+            t0, t1 = (min_b - max_a) / r, (max_b - min_a) / r
+            if r < 0:
+                t0, t1 = t1, t0
+            lo, hi = max(lo, t0), min(hi, t1)
+            if lo > hi:
+                return None
+    return lo, hi
+
+
+def time_to_contact(
+    robot_polygon: np.ndarray,
+    robot_velocity: np.ndarray,
+    pedestrian: Pedestrian,
+    now: float,
+    lookahead: float,
+) -> float | None:
+    """Seconds from `now` until the footprints first meet, None if not within `lookahead`.
+
+    The robot's footprint translates at `robot_velocity` (it keeps its course); the
+    pedestrian follows its path, one straight piece at a time. Everything is in
+    highway-env's frame, which only mirrors the world, so distances and contacts agree.
+    """
+    cuts = [now, *pedestrian.path.breakpoints_between(now, now + lookahead), now + lookahead]
+    for t0, t1 in zip(cuts[:-1], cuts[1:], strict=True):
+        offset = t0 - now
+        window = contact_window(
+            robot_polygon + offset * robot_velocity,
+            robot_velocity,
+            pedestrian.polygon_at(t0),
+            pedestrian.highway_velocity_at(t0),
+            t1 - t0,
+        )
+        if window is not None:
+            return offset + window[0]
+    return None
+
+
+def polygons_intersect(poly_a: np.ndarray, poly_b: np.ndarray) -> bool:
+    """highway-env's static intersection test of two footprints."""
+    zero = np.zeros(2)
+    return bool(utils.are_polygons_intersecting(poly_a, poly_b, zero, zero)[0])
+
+
+def occluded_landmarks(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    camera_world: np.ndarray,
+    points_world: np.ndarray,
+    own_geoms: np.ndarray,
+) -> np.ndarray:
+    """Per point: is the line of sight from the camera blocked by a geom not in own_geoms?"""
+    own = set(int(g) for g in own_geoms)
+    hidden = np.zeros(len(points_world), dtype=bool)
+    geom_id = np.zeros(1, dtype=np.int32)
+    origin = np.asarray(camera_world, dtype=float)
+    for k, point in enumerate(np.asarray(points_world, dtype=float)):
+        ray = point - origin
+        dist = float(np.linalg.norm(ray))
+        if dist < 1e-9:
+            continue
+        hit = mujoco.mj_ray(model, data, origin, ray / dist, VISIBLE_GEOM_GROUPS, 1, -1, geom_id)
+        if 0 <= hit < dist - OCCLUSION_TOLERANCE and int(geom_id[0]) not in own:
+            hidden[k] = True
+    return hidden
+
+
+def facing_angles(
+    robot: Pose2D, camera: CameraModel, position: np.ndarray, heading: float
+) -> tuple[float, float, float, float]:
+    """(facing_yaw, facing_yaw_view, beta, phi_deg) of a pedestrian seen by the camera."""
+    cam = robot.to_world(camera.position)
+    bearing = math.atan2(position[1] - cam[1], position[0] - cam[0])
+    facing = wrap_angle(heading - robot.yaw)
+    facing_view = wrap_angle(heading - bearing)
+    beta = math.asin(max(-1.0, min(1.0, math.sin(facing_view))))
+    return facing, facing_view, beta, 2.0 * math.degrees(beta)
+
+
+def in_image(camera: CameraModel, px: np.ndarray) -> np.ndarray:
+    """Per pixel (N, 2): finite and inside the image."""
+    u, v = px[:, 0], px[:, 1]
+    with np.errstate(invalid="ignore"):
+        return (
+            np.isfinite(u)
+            & np.isfinite(v)
+            & (u >= 0)
+            & (v >= 0)
+            & (u < camera.width)
+            & (v < camera.height)
+        )
+
+
+def case_label(velocity_world: np.ndarray, robot_yaw: float) -> tuple[Case, np.ndarray]:
+    """The case of a world ground velocity seen in the robot's axes, and that velocity."""
+    c, s = math.cos(robot_yaw), math.sin(robot_yaw)
+    vx, vy = float(velocity_world[0]), float(velocity_world[1])
+    forward, left = c * vx + s * vy, -s * vx + c * vy
+    return case_from_ground_velocity(forward, left), np.array([forward, left])

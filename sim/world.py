@@ -1,0 +1,265 @@
+"""The simulated world: one step advances highway-env, poses MuJoCo, renders, tells the truth.
+
+highway-env owns the motion: the robot is a highway-env vehicle (sim.robot) on a
+highway-env road, the pedestrian a highway-env road object walking its scenario path
+(sim.pedestrian). MuJoCo only shows it: each step puts the camera robot and the
+mannequin where highway-env says, renders the robot camera and reads the mannequin's
+landmarks for the ground truth (sim.ground_truth). The scenario runner, the gymnasium
+environment and the closed loop all call the same `World.step`.
+
+Rendering: the MuJoCo renderer (an EGL context) is created lazily on the first frame, in
+the process that steps the world; EGL contexts do not survive fork, so build Worlds
+inside spawned workers from the (plain-data) Scenario. With `render=False` no renderer is
+ever made and `WorldStep.frame` is None; everything else, the ground truth included
+(occlusion is a ray test, not a mask), is the same, which makes ground-truth-only runs fast.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from types import TracebackType
+
+import numpy as np
+from highway_env.road.road import Road
+
+from monopic.camera import CameraModel
+from monopic.frame import EgoState, Frame
+from sim.frames import Pose2D, wrap_angle
+from sim.ground_truth import (
+    CASE_WINDOW,
+    TORSO_LANDMARKS,
+    GroundTruth,
+    RobotState,
+    case_label,
+    facing_angles,
+    in_image,
+    occluded_landmarks,
+    polygons_intersect,
+    time_to_contact,
+)
+from sim.pedestrian import PathState, Pedestrian
+from sim.render import Marker, SceneRenderer
+from sim.robot import Robot, highway_road
+from sim.scenario import Scenario
+from sim.scene import Scene, SceneConfig
+
+ROBOT_START = Pose2D(0.0, 0.0, 0.0)  # the world origin, heading east along the road
+TTC_LOOKAHEAD = 10.0  # s: how far ahead the time to collision is searched
+
+
+@dataclass(frozen=True)
+class WorldStep:
+    """One frame of the world: the camera frame (None without rendering) and the truth.
+
+    `frame.ego` (and `ego`) is all the pipeline may know besides the pixels.
+    """
+
+    index: int
+    time: float
+    ego: EgoState
+    truth: GroundTruth
+    frame: Frame | None
+
+
+class World:
+    """A scenario brought to life; call reset() first, then step() once per frame."""
+
+    def __init__(
+        self, scenario: Scenario, render: bool = True, ttc_lookahead: float = TTC_LOOKAHEAD
+    ) -> None:
+        if not ttc_lookahead >= scenario.horizon:
+            raise ValueError("the time-to-collision lookahead must cover the horizon")
+        self.scenario = scenario
+        self.render_frames = render
+        self.ttc_lookahead = ttc_lookahead
+        self.camera: CameraModel = scenario.robot.camera.model()
+        scene_spec = scenario.scene
+        self.scene = Scene(
+            SceneConfig(
+                camera=self.camera,
+                road=scene_spec.road,
+                pedestrian=scenario.pedestrian.looks,
+                occluders=scene_spec.occluders,
+                sun_azimuth_deg=scene_spec.sun_azimuth_deg,
+                sun_elevation_deg=scene_spec.sun_elevation_deg,
+            )
+        )
+        self._renderer: SceneRenderer | None = None
+        self.road: Road | None = None
+        self.robot: Robot | None = None
+        self.pedestrian: Pedestrian | None = None
+        self.time = 0.0
+        self.index = 0
+        self.seed = scenario.seed
+        self._yaw_rate = 0.0
+        self.last: WorldStep | None = None
+
+    # -- stepping ---------------------------------------------------------------------
+
+    def reset(self, seed: int | None = None) -> WorldStep:
+        """Back to the scenario's start; the seed (default the scenario's) sets the gait phase."""
+        self.seed = self.scenario.seed if seed is None else int(seed)
+        rng = np.random.default_rng(self.seed)
+        self.road = highway_road(self.scenario.scene.road, self.scenario.scene.occluders)
+        self.robot = Robot(self.road, self.scenario.robot, ROBOT_START)
+        self.road.vehicles.append(self.robot)
+        self.pedestrian = Pedestrian(self.road, self.scenario.pedestrian, self.scene.gait)
+        self.pedestrian.reset(gait_phase=float(rng.uniform()))
+        self.road.objects.append(self.pedestrian)
+        self.time, self.index, self._yaw_rate = 0.0, 0, 0.0
+        return self._observe()
+
+    def step(self, dt: float | None = None, action: float = 0.0) -> WorldStep:
+        """Advance by dt (default the scenario's) with the robot accelerating at `action` m/s^2.
+
+        Order: the robot takes the action, the pedestrian walks, highway-env's road steps
+        the robot's kinematics and its collision checks, then MuJoCo is posed, the camera
+        renders and the ground truth is read at the new time.
+        """
+        if self.robot is None or self.pedestrian is None or self.road is None:
+            raise RuntimeError("call World.reset() before World.step()")
+        dt = self.scenario.dt if dt is None else float(dt)
+        if not (math.isfinite(dt) and dt > 0):
+            raise ValueError(f"time step must be positive, got {dt}")
+        yaw_before = self.robot.world_pose.yaw
+        self.robot.act(float(action))
+        self.pedestrian.step(dt)
+        self.road.act()
+        self.road.step(dt)
+        self._yaw_rate = wrap_angle(self.robot.world_pose.yaw - yaw_before) / dt
+        self.time = self.pedestrian.time
+        self.index += 1
+        return self._observe()
+
+    def run(self, policy: Callable[[WorldStep], float] | None = None) -> Iterator[WorldStep]:
+        """The scenario's frames from reset(); `policy` maps each step to the next action."""
+        step = self.reset()
+        yield step
+        for _ in range(self.scenario.frames - 1):
+            step = self.step(action=policy(step) if policy else 0.0)
+            yield step
+
+    # -- rendering --------------------------------------------------------------------
+
+    def render(self, markers: tuple[Marker, ...] = ()) -> np.ndarray:
+        """The robot camera's image of the current state (RGB uint8), e.g. with test markers."""
+        if self._renderer is None:
+            self._renderer = SceneRenderer(self.scene)
+        return self._renderer.render(markers)
+
+    def pedestrian_mask(self) -> np.ndarray:
+        """Pixels where the pedestrian is visible in the current image (bool, H x W)."""
+        if self._renderer is None:
+            self._renderer = SceneRenderer(self.scene)
+        return self._renderer.pedestrian_mask()
+
+    def close(self) -> None:
+        if self._renderer is not None:
+            self._renderer.close()
+            self._renderer = None
+
+    def __enter__(self) -> World:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+    # -- truth ------------------------------------------------------------------------
+
+    def robot_state(self) -> RobotState:
+        assert self.robot is not None
+        pose = self.robot.world_pose
+        return RobotState(
+            time=self.time,
+            position=np.array([pose.x, pose.y]),
+            yaw=pose.yaw,
+            speed=float(self.robot.speed),
+            acceleration=float(self.robot.applied_acceleration),
+            yaw_rate=self._yaw_rate,
+            length=self.scenario.robot.length,
+            width=self.scenario.robot.width,
+        )
+
+    def _observe(self) -> WorldStep:
+        assert self.robot is not None and self.pedestrian is not None
+        robot = self.robot_state()
+        ped = self.pedestrian.state
+        self.scene.set_camera_pose(robot.pose.x, robot.pose.y, robot.pose.yaw)
+        self.scene.set_pedestrian(
+            ped.position[0], ped.position[1], ped.yaw, self.pedestrian.gait_phase, ped.speed
+        )
+        truth = self._ground_truth(robot, ped)
+        ego = EgoState(self.camera, robot.speed, robot.yaw_rate)
+        frame = Frame(self.render(), self.time, ego, self.index) if self.render_frames else None
+        self.last = WorldStep(self.index, self.time, ego, truth, frame)
+        return self.last
+
+    def _ground_truth(self, robot: RobotState, ped: PathState) -> GroundTruth:
+        assert self.robot is not None and self.pedestrian is not None
+        scenario, scene, camera = self.scenario, self.scene, self.camera
+        pose = robot.pose
+        c, s = math.cos(pose.yaw), math.sin(pose.yaw)
+
+        def axes(v: np.ndarray) -> np.ndarray:  # world vector -> robot axes
+            return np.array([c * v[0] + s * v[1], -s * v[0] + c * v[1]])
+
+        def local(p: np.ndarray) -> np.ndarray:  # world point -> robot frame
+            return pose.to_local(np.array([p[0], p[1], 0.0]))[:2]
+
+        path = self.pedestrian.path
+        robot_velocity = robot.speed * np.array([c, s])
+        ahead = path.state(self.time + CASE_WINDOW).position
+        case, case_velocity = case_label((ahead - ped.position) / CASE_WINDOW, pose.yaw)
+        future = path.state(self.time + scenario.horizon).position
+
+        robot_polygon = self.robot.polygon()
+        contact = polygons_intersect(robot_polygon, self.pedestrian.polygon())
+        ttc = time_to_contact(
+            robot_polygon, self.robot.velocity, self.pedestrian, self.time, self.ttc_lookahead
+        )
+
+        body = scene.truth()
+        centre_px = camera.project(body.landmarks_robot[list(TORSO_LANDMARKS)].mean(axis=0))
+        camera_world = scene.data.cam_xpos[scene.camera_id].copy()
+        hidden = occluded_landmarks(
+            scene.model, scene.data, camera_world, body.landmarks_world, scene.mannequin.geom_ids
+        )
+        visible = in_image(camera, body.landmarks_px) & ~hidden
+        facing, facing_view, beta, phi = facing_angles(pose, camera, ped.position, ped.yaw)
+        return GroundTruth(
+            time=self.time,
+            index=self.index,
+            robot=robot,
+            position_world=ped.position.copy(),
+            velocity_world=ped.velocity,
+            heading_world=ped.yaw,
+            speed=ped.speed,
+            position_robot=local(ped.position),
+            velocity_robot=axes(ped.velocity),
+            relative_velocity_robot=axes(ped.velocity - robot_velocity),
+            heading_robot=wrap_angle(ped.yaw - pose.yaw),
+            case=case,
+            case_velocity_robot=case_velocity,
+            horizon=scenario.horizon,
+            future_position_world=future,
+            future_position_robot=local(future),
+            contact=contact,
+            collision=ttc is not None and ttc <= scenario.horizon,
+            time_to_collision=ttc,
+            body=body,
+            centre_px=centre_px,
+            landmarks_occluded=hidden,
+            visible_fraction=float(visible.mean()),
+            occluded=bool(hidden.mean() > 0.5),
+            facing_yaw=facing,
+            facing_yaw_view=facing_view,
+            beta=beta,
+            phi=phi,
+        )
