@@ -21,48 +21,15 @@ from dataclasses import dataclass
 import mujoco
 import numpy as np
 
+from monopic.pose.skeleton import LANDMARK_NAMES
 from sim.frames import yaw_quat
 from sim.gait import JOINT_FIELDS, MannequinPose
 
 RGBA = tuple[float, float, float, float]
 
 # BlazePose's 33 landmarks, indexed as MediaPipe numbers them; left/right are the
-# person's own.
-BLAZEPOSE_NAMES: tuple[str, ...] = (
-    "nose",
-    "left_eye_inner",
-    "left_eye",
-    "left_eye_outer",
-    "right_eye_inner",
-    "right_eye",
-    "right_eye_outer",
-    "left_ear",
-    "right_ear",
-    "mouth_left",
-    "mouth_right",
-    "left_shoulder",
-    "right_shoulder",
-    "left_elbow",
-    "right_elbow",
-    "left_wrist",
-    "right_wrist",
-    "left_pinky",
-    "right_pinky",
-    "left_index",
-    "right_index",
-    "left_thumb",
-    "right_thumb",
-    "left_hip",
-    "right_hip",
-    "left_knee",
-    "right_knee",
-    "left_ankle",
-    "right_ankle",
-    "left_heel",
-    "right_heel",
-    "left_foot_index",
-    "right_foot_index",
-)
+# person's own. One list for the whole project: the pipeline's.
+BLAZEPOSE_NAMES = LANDMARK_NAMES
 N_LANDMARKS = len(BLAZEPOSE_NAMES)
 
 # Geom and site groups: the robot camera shows geom groups 0-2; sites are kept in a

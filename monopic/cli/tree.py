@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from monopic.cli.args import non_negative_float, positive_int
 from monopic.errors import UserError
 from monopic.replay.dataset import prepare
 from monopic.replay.logs import read_log
@@ -12,26 +13,6 @@ from monopic.replay.training import DEFAULT_MIN_SAMPLES, DISCRETISERS, TrainOpti
 from monopic.tree.discretise import AUTHORS_DEAD_ZONE
 from monopic.tree.report import summary, tree_dot
 from monopic.tree.serialise import load_model, save_model
-
-
-def positive_int(text: str) -> int:
-    try:
-        v = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not an integer") from None
-    if v < 1:
-        raise argparse.ArgumentTypeError(f"{v} is not >= 1")
-    return v
-
-
-def non_negative_float(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
-    if not v >= 0:
-        raise argparse.ArgumentTypeError(f"{v} is not >= 0")
-    return v
 
 
 def add_training_options(p: argparse.ArgumentParser) -> None:
