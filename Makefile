@@ -12,13 +12,17 @@ install: $(STAMP)
 # (Re)install when the project's dependency pins change.
 $(STAMP): pyproject.toml requirements.lock
 	@test -x $(BIN)/python || $(PY) -m venv $(VENV)
-	$(BIN)/python -m pip install -q -c requirements.lock -e '.[dev]'
+	$(BIN)/python -m pip install -q -c requirements.lock -e '.[dev,ray]'
 	@touch $(STAMP)
 
+# The pipeline on the shipped clip, then the default sweep of every case and family
+# through the simulator, its report and headline table (about 10 minutes on 2 cores).
 demo: $(STAMP)
 	@mkdir -p recordings
 	$(BIN)/monopic video tests/data/walk_clip.mp4 --variant warning \
 		--out recordings/demo.mp4 --csv recordings/demo.csv --rrd recordings/demo.rrd
+	$(BIN)/monopic sweep scenarios/sweeps/demo.toml --out recordings/demo.jsonl
+	$(BIN)/monopic report recordings/demo.jsonl --out recordings/demo_report
 
 test: $(STAMP) lint
 	$(BIN)/python -m pytest -q

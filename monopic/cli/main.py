@@ -15,6 +15,12 @@ COMMAND_MODULES = (
     "monopic.cli.video",
     "monopic.cli.tree",
     "monopic.cli.replay",
+    "monopic.cli.record",
+    "monopic.cli.view",
+    "monopic.cli.dataset",
+    "monopic.cli.closed_loop",
+    "monopic.cli.sweep",
+    "monopic.cli.report",
 )
 
 

@@ -1,0 +1,41 @@
+"""`monopic report RESULTS`: Markdown report with plots from a sweep's results, headline printed."""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser("report", help="write the Markdown report of a sweep's results file")
+    p.add_argument("results", type=Path, help="results file written by monopic sweep (.jsonl)")
+    p.add_argument(
+        "--out", type=Path, help="report folder (default: beside RESULTS, <name>_report/)"
+    )
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from monopic.errors import UserError
+    from sim.metrics import compute
+    from sim.report import ran_on, write_report
+    from sim.results_file import read_rows
+
+    results: Path = args.results
+    if not results.is_file():
+        raise UserError(f"{results}: no such results file")
+    rows = list(read_rows(results))
+    if not rows:
+        raise UserError(f"{results}: no finished runs in it yet")
+    for number, row in enumerate(rows, start=1):
+        if row.get("schema") != 1 or "truth" not in row:
+            raise UserError(f"{results}:{number}: not a sweep result line (schema 1)")
+    out = args.out or results.with_name(f"{results.stem}_report")
+    if out.exists() and not out.is_dir():
+        raise UserError(f"--out {out}: exists and is not a folder")
+    metrics = compute(rows)
+    report = write_report(metrics, rows, results, out)
+    print(report.headline)
+    print(f"\n{ran_on(metrics)}")
+    print(f"report: {report.markdown} ({len(report.plots)} plots)")
+    return 0

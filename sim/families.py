@@ -1,0 +1,264 @@
+"""What a scenario family means: robot presets, looks, lighting, and NCAP-style placement.
+
+Euro NCAP's pedestrian tests put the pedestrian so that, if nobody brakes, the front of
+the vehicle strikes them at a chosen point across its width at a chosen time. Here that
+is solved backwards: from the robot's speed, the impact time and the impact point the
+pedestrian's start position (and, when it would otherwise start too far away, a standing
+delay before it walks) follow exactly, so the ground-truth path meets the robot's
+footprint where the family says. Everything is in the world frame of sim.frames with
+the robot starting at the origin heading east (+x); right-hand traffic, so the nearside
+is the robot's right (-y) and the far side its left (+y).
+
+Impact point convention: a fraction of the robot's width measured from the edge the
+pedestrian comes from (crossing) or from the robot's right edge (longitudinal). Values
+in [0, 1] strike the front; values outside make a near miss (above 1: the pedestrian has
+cleared the far edge when the robot passes; below 0: it has not reached the path yet).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+from enum import StrEnum
+
+from sim.mannequin import MannequinSpec
+from sim.road import Occluder, RoadLayout
+from sim.scenario import CameraSpec, Leg, PedestrianSpec, RobotSpec
+
+# Clearance between the pedestrian and the kerb line when it stops or turns there.
+KERB_STOP_GAP = 0.2  # m
+
+
+class Scale(StrEnum):
+    """The two robot sizes the families are written for."""
+
+    CAR = "car"
+    SMALL = "small"
+
+
+@dataclass(frozen=True)
+class ScalePreset:
+    """Defaults a scenario file gets from its `scale`: robot, camera, road, horizon."""
+
+    robot: RobotSpec
+    road: RoadLayout
+    horizon: float  # s, the warning horizon
+
+
+# A small camera-carrying robot (0.6 m wide) on the right lane of a two-lane street, the
+# paper's 1 s horizon. The camera is the project's default (768x432, 65 deg, 1.2 m).
+SMALL = ScalePreset(
+    robot=RobotSpec(speed=2.0, width=0.6, length=0.8, camera=CameraSpec(), max_speed=3.0),
+    road=RoadLayout(lanes=2, lane_width=3.5, center_y=1.75),
+    horizon=1.0,
+)
+
+# A family car (1.8 m x 4.5 m) in the middle lane of a three-lane street whose nearside
+# lane is a parking lane. Its camera sits behind the windscreen (1.3 m high, 0.8 m ahead
+# of the footprint's centre) with a narrower field of view than the small robot's, as
+# automotive forward cameras have. The 2 s horizon lets a warning come at a time to
+# collision of 1.7 s or more (Euro NCAP's timely forward collision warning).
+CAR = ScalePreset(
+    robot=RobotSpec(
+        speed=8.33,
+        width=1.8,
+        length=4.5,
+        camera=CameraSpec(
+            vertical_fov_deg=45.0, mount_height=1.3, pitch_deg=2.0, mount_forward=0.8
+        ),
+        max_speed=20.0,
+        max_deceleration=9.0,
+    ),
+    road=RoadLayout(lanes=3, lane_width=3.0, center_y=0.0),
+    horizon=2.0,
+)
+
+SCALES: dict[Scale, ScalePreset] = {Scale.CAR: CAR, Scale.SMALL: SMALL}
+
+# Sun positions (azimuth CCW from east where the light comes from, elevation), degrees.
+# The robot drives east, so azimuth 0 is a low sun straight ahead (backlit pedestrians).
+LIGHTING: dict[str, tuple[float, float]] = {
+    "noon": (210.0, 60.0),
+    "morning": (120.0, 25.0),
+    "low-sun-behind": (180.0, 10.0),
+    "low-sun-ahead": (15.0, 10.0),
+}
+
+BODIES = ("adult", "child")
+
+# Clothing presets: overrides of MannequinSpec's colours and patterns.
+CLOTHING: dict[str, dict[str, object]] = {
+    "default": {},
+    "dark": {
+        "shirt": (0.07, 0.07, 0.08, 1.0),
+        "trousers": (0.05, 0.05, 0.06, 1.0),
+        "long_sleeves": True,
+    },
+    "bright": {"shirt": (0.95, 0.78, 0.1, 1.0), "trousers": (0.25, 0.3, 0.6, 1.0)},
+    "light": {"shirt": (0.9, 0.9, 0.88, 1.0), "trousers": (0.72, 0.66, 0.52, 1.0)},
+    "checker": {"shirt_pattern": "checker"},
+}
+
+
+def mannequin(body: str, clothing: str, height: float | None = None) -> MannequinSpec:
+    """The mannequin for a body preset (adult 1.8 m, child 1.15 m) in a clothing preset."""
+    maker = MannequinSpec.adult if body == "adult" else MannequinSpec.child
+    looks = maker(**CLOTHING[clothing])
+    return looks if height is None else replace(looks, height=height)
+
+
+def street_bounds(road: RoadLayout) -> tuple[float, float, float, float]:
+    """(x_min, x_max, y_min, y_max) of the walkable street: road, kerbs and pavements."""
+    kerb = 0.15
+    y_right, y_left = road.edges
+    half = road.length / 2
+    return -half, half, y_right - kerb - road.pavement_width, y_left + kerb + road.pavement_width
+
+
+class Side(StrEnum):
+    NEAR = "near"  # from the robot's right (the kerb side in right-hand traffic)
+    FAR = "far"  # from its left, across the other lanes
+
+
+class Then(StrEnum):
+    """What a crossing pedestrian does after starting to walk."""
+
+    WALK = "walk"  # keeps walking across
+    STOP_AT_KERB = "stop-at-kerb"  # stops short of the kerb (a near miss)
+    TURN_AWAY = "turn-away"  # turns at the kerb and walks off along the pavement (a near miss)
+
+
+@dataclass(frozen=True)
+class Crossing:
+    """A pedestrian crossing the robot's path at right angles (CPNA, CPFA, CPNCO).
+
+    The pedestrian's centre reaches the impact point's lateral position at `impact_time`,
+    having walked `approach` metres from where it stood; the crossing line lies where the
+    robot's front is at that time (a standing robot: `standstill_distance` ahead of it).
+    """
+
+    side: Side
+    impact_point: float  # fraction of the width from the entering edge
+    impact_time: float  # s from the start
+    approach: float  # m walked from the start to the impact point's lateral position
+    then: Then = Then.WALK
+    standstill_distance: float = 4.0  # m between a standing robot's front and the line
+
+
+@dataclass(frozen=True)
+class Longitudinal:
+    """A pedestrian walking along the robot's path (CPLA: away; or toward it).
+
+    Walking away, the robot reaches the pedestrian at `impact_time` when it is faster;
+    otherwise (or standing) the pedestrian starts `standstill_distance` ahead of the
+    front and is never reached.
+    """
+
+    impact_point: float  # fraction of the width from the robot's right edge
+    impact_time: float
+    toward: bool = False
+    standstill_distance: float = 4.0
+
+
+class PlacementError(ValueError):
+    """A placement that cannot be built; `field` names the offending path key."""
+
+    def __init__(self, field: str, value: object, reason: str) -> None:
+        super().__init__(reason)
+        self.field = field
+        self.value = value
+        self.reason = reason
+
+
+def crossing_line_x(
+    robot: RobotSpec, footprint: float, impact_time: float, standstill: float
+) -> float:
+    """World x of the pedestrian's centre line when the robot's front touches it."""
+    front = robot.length / 2
+    if robot.speed > 0:
+        return robot.speed * impact_time + front + footprint / 2
+    return front + footprint / 2 + standstill
+
+
+def place_crossing(
+    c: Crossing, robot: RobotSpec, road: RoadLayout, speed: float, looks: MannequinSpec,
+    footprint: float = 0.5,
+) -> PedestrianSpec:  # fmt: skip
+    """The pedestrian of a crossing (see Crossing), legs included for the near misses."""
+    if not speed > 0:
+        raise PlacementError("pedestrian.speed", speed, "a crossing pedestrian must walk (> 0 m/s)")
+    direction = 1.0 if c.side is Side.NEAR else -1.0  # +1 walks north (to the robot's left)
+    entering_edge = -direction * robot.width / 2
+    y_impact = entering_edge + direction * c.impact_point * robot.width
+    x_line = crossing_line_x(robot, footprint, c.impact_time, c.standstill_distance)
+    walk_time = c.approach / speed
+    start_delay = c.impact_time - walk_time
+    if start_delay < 0:
+        raise PlacementError(
+            "path.approach",
+            c.approach,
+            f"walking {c.approach} m at {speed:.3g} m/s takes {walk_time:.3g} s, longer than "
+            f"impact_time {c.impact_time} s",
+        )
+    y0 = y_impact - direction * c.approach
+    legs: tuple[Leg, ...] = ()
+    if c.then is not Then.WALK:
+        y_right, y_left = road.edges
+        kerb = y_right if direction > 0 else y_left
+        y_stop = kerb - direction * (footprint / 2 + KERB_STOP_GAP)
+        to_kerb = (y_stop - y0) * direction
+        if to_kerb <= 0:
+            raise PlacementError(
+                "path.approach",
+                c.approach,
+                f"the pedestrian starts past the kerb (y={y0:.2f} m), so it cannot {c.then} there",
+            )
+        at = start_delay + to_kerb / speed
+        # Turning away: a quarter turn to walk along the pavement in the robot's direction.
+        turn = -90.0 * direction
+        leg = Leg(at=at, speed=0.0) if c.then is Then.STOP_AT_KERB else Leg(at, speed, turn)
+        legs = (leg,)
+    return PedestrianSpec(
+        x=x_line,
+        y=y0,
+        heading_deg=90.0 * direction,
+        speed=speed,
+        looks=looks,
+        legs=legs,
+        start_delay=start_delay,
+        footprint=footprint,
+    )
+
+
+def place_longitudinal(
+    c: Longitudinal, robot: RobotSpec, speed: float, looks: MannequinSpec, footprint: float = 0.5
+) -> PedestrianSpec:
+    """The pedestrian of a walk along the path (see Longitudinal)."""
+    y = -robot.width / 2 + c.impact_point * robot.width
+    front = robot.length / 2 + footprint / 2
+    meet = robot.speed * c.impact_time + front
+    if c.toward:
+        x0 = meet + speed * c.impact_time
+    elif robot.speed > speed:
+        x0 = meet - speed * c.impact_time
+    else:
+        x0 = front + c.standstill_distance
+    return PedestrianSpec(
+        x=x0,
+        y=y,
+        heading_deg=180.0 if c.toward else 0.0,
+        speed=speed,
+        looks=looks,
+        footprint=footprint,
+    )
+
+
+def parked_cars_around(x_line: float, y: float, gap: float) -> tuple[Occluder, Occluder]:
+    """Two parked cars leaving `gap` metres free around the crossing line (CPNCO)."""
+    length = Occluder.parked_car(0.0, 0.0).length
+    offset = gap / 2 + length / 2
+    return (
+        Occluder.parked_car(x_line - offset, y, colour=(0.55, 0.1, 0.1)),
+        Occluder(
+            x=x_line + offset, y=y, length=4.9, width=1.9, height=1.8, colour=(0.2, 0.3, 0.45)
+        ),
+    )

@@ -1,0 +1,607 @@
+"""Metrics over sweep results: collision-warning quality, cases, phi, positions, pose, latency.
+
+Definitions (the report states them too):
+
+- Frame level: a frame is positive when the ground truth shows contact within the
+  horizon (the robot keeping its course); a warning on a negative frame is a false alarm.
+  Recall = TP / (TP + FN), precision = TP / (TP + FP), false-alarm rate = FP / (FP + TN).
+  A predictor that made no decision on a frame (no pose, or no ground point) did not warn.
+- Run level: a collision run has at least one positive frame. Its warning onset is the
+  first warning while the ground truth is on a collision course (a contact ahead within
+  the truth's lookahead); lead time = contact time - onset. Recall = warned collision
+  runs / collision runs, with its 95 % Wilson lower bound; recall@1s counts only onsets
+  at least 1 s before contact, "timely" at least 1.7 s (Euro NCAP's forward collision
+  warning bar, for car-scale families). A non-collision run is warned when any frame
+  warns; near-miss runs are the non-collision runs of near-miss families.
+- Latency applied: the pipeline runs in real time on one core: it takes a frame only when
+  it is idle, and a frame's warning exists from capture time + that frame's measured
+  latency (pose + features + this predictor's share of predict and warning). Frames that
+  arrive while it is busy are skipped. Decisions are those of the full-rate run (the
+  features' velocity windows assume every frame), which favours the pipeline slightly.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter, defaultdict
+from collections.abc import Callable, Iterable, Sequence
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+Z95 = 1.959963984540054
+MAIN = "main"
+ABLATION = "gtcrop"
+TIMELY_TTC = 1.7  # s, Euro NCAP's timely forward collision warning
+LEAD_GOAL = 1.0  # s, the issue's goal: warned at least this long before contact
+RANGE_BINS = (0.0, 5.0, 10.0, 15.0, 20.0, 30.0, 50.0, 1e9)  # m
+HEIGHT_BINS = (0.0, 30.0, 60.0, 120.0, 240.0, 1e9)  # px
+RADII = tuple(range(0, 301, 5))  # px, for accuracy against error radius
+
+
+def wilson(successes: int, n: int, z: float = Z95) -> tuple[float, float]:
+    """Wilson score interval (low, high) of a binomial proportion; (nan, nan) when n = 0."""
+    if n == 0:
+        return math.nan, math.nan
+    p = successes / n
+    denom = 1 + z * z / n
+    centre = (p + z * z / (2 * n)) / denom
+    half = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / denom
+    return max(0.0, centre - half), min(1.0, centre + half)
+
+
+def ratio(num: float, den: float) -> float:
+    return num / den if den else math.nan
+
+
+def method_name(pipeline: str, key: str) -> str:
+    """'rules/image' for the real pipeline, 'gtcrop:rules/image' for the ablation."""
+    return key if pipeline == MAIN else f"{pipeline}:{key}"
+
+
+def split_method(method: str) -> tuple[str, str]:
+    if ":" in method:
+        pipeline, key = method.split(":", 1)
+        return pipeline, key
+    return MAIN, method
+
+
+def methods(rows: Iterable[dict[str, Any]]) -> list[str]:
+    """Every (pipeline, predictor) pair present, main pipeline first, in a stable order."""
+    found: dict[str, None] = {}
+    for row in rows:
+        for pipeline in (MAIN, ABLATION):
+            for key in row["pipelines"].get(pipeline, {}).get("decisions", {}):
+                found[method_name(pipeline, key)] = None
+    return sorted(found, key=_method_order)
+
+
+_ORDER = {"image": 0, "ground": 1, "rules": 0, "id3-tree": 1, "constant-velocity": 2}
+
+
+def _method_order(method: str) -> tuple[int, int, int, str]:
+    """Main pipeline first; image mode, then ground; rules, tree, constant velocity."""
+    pipeline, key = split_method(method)
+    name, _, mode = key.partition("/")
+    return (pipeline != MAIN, _ORDER.get(mode, 9), _ORDER.get(name, 9), key)
+
+
+def dedupe(rows: Iterable[dict[str, Any]]) -> list[dict[str, Any]]:
+    """One row per run id (the first), so a file appended twice counts each run once."""
+    seen: set[str] = set()
+    out = []
+    for row in rows:
+        if row["id"] not in seen:
+            seen.add(row["id"])
+            out.append(row)
+    return out
+
+
+# -- per run ----------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class FrameCounts:
+    tp: int = 0
+    fp: int = 0
+    fn: int = 0
+    tn: int = 0
+
+    def __add__(self, other: FrameCounts) -> FrameCounts:
+        return FrameCounts(
+            self.tp + other.tp, self.fp + other.fp, self.fn + other.fn, self.tn + other.tn
+        )
+
+    @property
+    def recall(self) -> float:
+        return ratio(self.tp, self.tp + self.fn)
+
+    @property
+    def precision(self) -> float:
+        return ratio(self.tp, self.tp + self.fp)
+
+    @property
+    def false_alarm_rate(self) -> float:
+        return ratio(self.fp, self.fp + self.tn)
+
+
+@dataclass(frozen=True)
+class RunOutcome:
+    """One run judged for one method (pipeline + predictor)."""
+
+    id: str
+    family: str
+    kind: str
+    scale: str
+    case: int
+    robot_speed: float
+    horizon: float
+    collision_run: bool
+    contact_time: float | None  # when the footprints first meet (truth), None if never
+    warned: bool  # any warning frame
+    onset: float | None  # first warning while on a collision course
+    onset_latency: float | None  # the same with the measured latency applied
+    frames: FrameCounts
+
+    @property
+    def lead(self) -> float | None:
+        if self.onset is None or self.contact_time is None:
+            return None
+        return self.contact_time - self.onset
+
+    @property
+    def lead_latency(self) -> float | None:
+        if self.onset_latency is None or self.contact_time is None:
+            return None
+        lead = self.contact_time - self.onset_latency
+        return lead if lead >= 0 else None
+
+    @property
+    def near_miss(self) -> bool:
+        return self.kind == "near-miss" and not self.collision_run
+
+
+def _decisions(row: dict[str, Any], method: str) -> dict[str, list[Any]] | None:
+    pipeline, key = split_method(method)
+    return row["pipelines"].get(pipeline, {}).get("decisions", {}).get(key)
+
+
+def run_case(row: dict[str, Any]) -> int:
+    """The run's case: the one the scenario was built for, else the most common true case."""
+    case = row["scenario"].get("case")
+    if case is not None:
+        return int(case)
+    return Counter(row["truth"]["case"]).most_common(1)[0][0]
+
+
+def contact_time(row: dict[str, Any]) -> float | None:
+    """First contact by the truth: where frames on a collision course say it will happen."""
+    truth = row["truth"]
+    times = [t + c for t, c in zip(truth["t"], truth["ttc"], strict=True) if c is not None]
+    return min(times) if times else None
+
+
+def frame_latency_ms(row: dict[str, Any], pipeline: str, k: int) -> float | None:
+    """Measured latency of frame k for one predictor: shared stages + its share of the rest."""
+    ms = row.get("timing", {}).get("ms", {}).get(pipeline)
+    if not ms:
+        return None
+    pose, feats = ms["pose"][k], ms["features"][k]
+    if pose is None:
+        return None
+    decisions = row["pipelines"][pipeline]["decisions"]
+    n = sum(1 for cols in decisions.values() if cols["warn"][k] is not None)
+    shared = (ms["predict"][k] or 0.0) + (ms["warning"][k] or 0.0)
+    return pose + (feats or 0.0) + (shared / n if n else 0.0)
+
+
+def available_times(row: dict[str, Any], pipeline: str) -> list[float | None]:
+    """When each frame's outputs exist on a real-time single-core pipeline (None: skipped)."""
+    times = row["truth"]["t"]
+    out: list[float | None] = []
+    busy_until = -math.inf
+    for k, t in enumerate(times):
+        latency = frame_latency_ms(row, pipeline, k)
+        if latency is None:
+            out.append(None)
+            continue
+        if t + 1e-9 < busy_until:
+            out.append(None)
+            continue
+        busy_until = t + latency / 1000.0
+        out.append(busy_until)
+    return out
+
+
+def judge_run(row: dict[str, Any], method: str) -> RunOutcome:
+    truth = row["truth"]
+    cols = _decisions(row, method)
+    n = len(truth["t"])
+    warn = [bool(v) for v in cols["warn"]] if cols else [False] * n
+    positive = [bool(v) for v in truth["collision"]]
+    on_course = [c is not None for c in truth["ttc"]]
+    counts = FrameCounts(
+        tp=sum(w and p for w, p in zip(warn, positive, strict=True)),
+        fp=sum(w and not p for w, p in zip(warn, positive, strict=True)),
+        fn=sum(p and not w for w, p in zip(warn, positive, strict=True)),
+        tn=sum(not w and not p for w, p in zip(warn, positive, strict=True)),
+    )
+    contact = contact_time(row)
+    onset = next((truth["t"][k] for k in range(n) if warn[k] and on_course[k]), None)
+    pipeline, _ = split_method(method)
+    avail = available_times(row, pipeline)
+    onset_latency = next(
+        (avail[k] for k in range(n) if warn[k] and on_course[k] and avail[k] is not None), None
+    )
+    scenario = row["scenario"]
+    return RunOutcome(
+        id=row["id"],
+        family=row["family"],
+        kind=row.get("kind", "case"),
+        scale=row.get("scale", ""),
+        case=run_case(row),
+        robot_speed=float(scenario["robot_speed"]),
+        horizon=float(scenario["horizon"]),
+        collision_run=any(positive),
+        contact_time=contact if any(positive) else None,
+        warned=any(warn),
+        onset=onset,
+        onset_latency=onset_latency,
+        frames=counts,
+    )
+
+
+# -- warning summaries ------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class WarningSummary:
+    """Collision-warning quality of one method over a group of runs."""
+
+    method: str
+    runs: int
+    collision_runs: int
+    warned: int  # collision runs with a warning onset before contact
+    warned_1s: int  # ... at least LEAD_GOAL before contact
+    timely: int  # ... at least TIMELY_TTC before contact
+    warned_latency: int
+    warned_1s_latency: int
+    near_miss_runs: int
+    near_miss_warned: int
+    other_runs: int  # non-collision runs that are not near-miss-family runs
+    other_warned: int
+    frames: FrameCounts
+    leads: tuple[float, ...]
+
+    @property
+    def recall(self) -> float:
+        return ratio(self.warned, self.collision_runs)
+
+    @property
+    def recall_low(self) -> float:
+        return wilson(self.warned, self.collision_runs)[0]
+
+    @property
+    def recall_1s(self) -> float:
+        return ratio(self.warned_1s, self.collision_runs)
+
+    @property
+    def recall_1s_low(self) -> float:
+        return wilson(self.warned_1s, self.collision_runs)[0]
+
+    @property
+    def timely_share(self) -> float:
+        return ratio(self.timely, self.collision_runs)
+
+    @property
+    def recall_latency(self) -> float:
+        return ratio(self.warned_latency, self.collision_runs)
+
+    @property
+    def recall_1s_latency(self) -> float:
+        return ratio(self.warned_1s_latency, self.collision_runs)
+
+    @property
+    def near_miss_warned_share(self) -> float:
+        return ratio(self.near_miss_warned, self.near_miss_runs)
+
+    @property
+    def lead_p50(self) -> float:
+        return float(np.median(self.leads)) if self.leads else math.nan
+
+    @property
+    def meets_goal(self) -> bool:
+        """The issue's goal: recall@1s lower bound >= 0.95 and <= 5 % of near misses warned."""
+        nm_ok = self.near_miss_runs == 0 or self.near_miss_warned_share <= 0.05
+        return self.collision_runs > 0 and self.recall_1s_low >= 0.95 and nm_ok
+
+
+def summarise(method: str, outcomes: Sequence[RunOutcome]) -> WarningSummary:
+    col = [o for o in outcomes if o.collision_run]
+    leads = [o.lead for o in col if o.lead is not None]
+    leads_lat = [o.lead_latency for o in col if o.lead_latency is not None]
+    near = [o for o in outcomes if o.near_miss]
+    other = [o for o in outcomes if not o.collision_run and not o.near_miss]
+    frames = sum((o.frames for o in outcomes), FrameCounts())
+    return WarningSummary(
+        method=method,
+        runs=len(outcomes),
+        collision_runs=len(col),
+        warned=len(leads),
+        warned_1s=sum(lead >= LEAD_GOAL for lead in leads),
+        timely=sum(lead >= TIMELY_TTC for lead in leads),
+        warned_latency=len(leads_lat),
+        warned_1s_latency=sum(lead >= LEAD_GOAL for lead in leads_lat),
+        near_miss_runs=len(near),
+        near_miss_warned=sum(o.warned for o in near),
+        other_runs=len(other),
+        other_warned=sum(o.warned for o in other),
+        frames=frames,
+        leads=tuple(leads),
+    )
+
+
+def group_by(
+    outcomes: Sequence[RunOutcome], key: Callable[[RunOutcome], Any]
+) -> dict[Any, list[RunOutcome]]:
+    groups: dict[Any, list[RunOutcome]] = defaultdict(list)
+    for o in outcomes:
+        groups[key(o)].append(o)
+    return dict(sorted(groups.items(), key=lambda kv: (str(type(kv[0])), kv[0])))
+
+
+# -- cases, phi, positions, pose, latency -------------------------------------------
+
+
+@dataclass(frozen=True)
+class CaseSummary:
+    method: str
+    frames: int  # frames with a decision
+    correct: int
+    confusion: np.ndarray  # 9 x 9 counts, rows true case 1-9, columns predicted
+
+    @property
+    def accuracy(self) -> float:
+        return ratio(self.correct, self.frames)
+
+
+def case_summary(rows: Sequence[dict[str, Any]], method: str) -> CaseSummary:
+    confusion = np.zeros((9, 9), dtype=int)
+    for row in rows:
+        cols = _decisions(row, method)
+        if not cols:
+            continue
+        for truth_case, pred in zip(row["truth"]["case"], cols["case"], strict=True):
+            if pred is not None:
+                confusion[truth_case - 1, pred - 1] += 1
+    return CaseSummary(method, int(confusion.sum()), int(np.trace(confusion)), confusion)
+
+
+@dataclass(frozen=True)
+class PositionSummary:
+    """Error of the predicted point at the real horizon (image px; ground m when predicted)."""
+
+    method: str
+    px: tuple[float, ...]
+    m: tuple[float, ...]
+
+    def px_percentile(self, q: float) -> float:
+        return float(np.percentile(self.px, q)) if self.px else math.nan
+
+    def m_percentile(self, q: float) -> float:
+        return float(np.percentile(self.m, q)) if self.m else math.nan
+
+    def accuracy_within(self, radii: Sequence[float] = RADII) -> np.ndarray:
+        """Share of predictions within each error radius (px), the paper's accuracy curve."""
+        errors = np.asarray(self.px)
+        if errors.size == 0:
+            return np.full(len(radii), math.nan)
+        return np.array([(errors <= r).mean() for r in radii])
+
+
+def position_summary(rows: Sequence[dict[str, Any]], method: str) -> PositionSummary:
+    """Predicted foot point at frame k vs the true foot point at frame k + horizon / dt."""
+    px_errors: list[float] = []
+    m_errors: list[float] = []
+    for row in rows:
+        cols = _decisions(row, method)
+        if not cols:
+            continue
+        truth = row["truth"]
+        ahead = int(round(row["scenario"]["horizon"] / row["scenario"]["dt"]))
+        n = len(truth["t"])
+        for k in range(n):
+            pred = cols["foot"][k]
+            if pred is not None and k + ahead < n and truth["foot"][k + ahead] is not None:
+                true = truth["foot"][k + ahead]
+                if None not in pred and None not in true:
+                    px_errors.append(math.dist(pred, true))
+            ground, future = cols["ground"][k], truth["future"][k]
+            if ground is not None and future is not None and None not in ground + future:
+                m_errors.append(math.dist(ground, future))
+    return PositionSummary(method, tuple(px_errors), tuple(m_errors))
+
+
+@dataclass(frozen=True)
+class PhiSummary:
+    pipeline: str
+    frames: int
+    mae: float  # degrees
+    correlation: float
+    pairs: tuple[tuple[float, float], ...] = field(repr=False)  # (true, measured)
+
+
+def phi_summary(rows: Sequence[dict[str, Any]], pipeline: str = MAIN) -> PhiSummary:
+    pairs = []
+    for row in rows:
+        measured = row["pipelines"].get(pipeline, {}).get("phi")
+        if measured is None:
+            continue
+        for true, got in zip(row["truth"]["phi"], measured, strict=True):
+            if true is not None and got is not None:
+                pairs.append((float(true), float(got)))
+    if not pairs:
+        return PhiSummary(pipeline, 0, math.nan, math.nan, ())
+    arr = np.array(pairs)
+    corr = (
+        float(np.corrcoef(arr.T)[0, 1]) if len(arr) > 2 and arr.std(axis=0).min() > 0 else math.nan
+    )
+    return PhiSummary(
+        pipeline, len(arr), float(np.abs(arr[:, 0] - arr[:, 1]).mean()), corr, tuple(pairs)
+    )
+
+
+@dataclass(frozen=True)
+class FoundShare:
+    """Share of frames with a pose, over frames where the pedestrian is in view."""
+
+    label: str
+    edges: tuple[float, ...]
+    seen: tuple[int, ...]
+    found: tuple[int, ...]
+
+    def shares(self) -> list[float]:
+        return [ratio(f, s) for f, s in zip(self.found, self.seen, strict=True)]
+
+
+def found_shares(
+    rows: Sequence[dict[str, Any]], pipeline: str = MAIN, min_visible: float = 0.5
+) -> tuple[FoundShare, FoundShare]:
+    """Pose found share by distance (m) and by true apparent height (px)."""
+    by_range = ([0] * (len(RANGE_BINS) - 1), [0] * (len(RANGE_BINS) - 1))
+    by_height = ([0] * (len(HEIGHT_BINS) - 1), [0] * (len(HEIGHT_BINS) - 1))
+    for row in rows:
+        found = row["pipelines"].get(pipeline, {}).get("found")
+        if found is None:
+            continue
+        truth = row["truth"]
+        for k, hit in enumerate(found):
+            visible = truth["visible"][k]
+            if not truth["in_frame"][k] or visible is None or visible < min_visible:
+                continue
+            for (seen, got), edges, value in (
+                (by_range, RANGE_BINS, truth["range"][k]),
+                (by_height, HEIGHT_BINS, truth["height"][k]),
+            ):
+                if value is None:
+                    continue
+                b = int(np.searchsorted(edges, value, side="right")) - 1
+                b = min(max(b, 0), len(edges) - 2)
+                seen[b] += 1
+                got[b] += int(hit)
+    return (
+        FoundShare("distance (m)", RANGE_BINS, tuple(by_range[0]), tuple(by_range[1])),
+        FoundShare("apparent height (px)", HEIGHT_BINS, tuple(by_height[0]), tuple(by_height[1])),
+    )
+
+
+def recall_by_range(
+    rows: Sequence[dict[str, Any]], method: str
+) -> tuple[tuple[float, ...], list[int], list[int]]:
+    """Frame-level recall by true distance: (bin edges, positives, warned positives)."""
+    pos = [0] * (len(RANGE_BINS) - 1)
+    hit = [0] * (len(RANGE_BINS) - 1)
+    for row in rows:
+        cols = _decisions(row, method)
+        truth = row["truth"]
+        for k, positive in enumerate(truth["collision"]):
+            if not positive or truth["range"][k] is None:
+                continue
+            b = min(
+                int(np.searchsorted(RANGE_BINS, truth["range"][k], side="right")) - 1, len(pos) - 1
+            )
+            pos[b] += 1
+            hit[b] += int(bool(cols and cols["warn"][k]))
+    return RANGE_BINS, pos, hit
+
+
+@dataclass(frozen=True)
+class LatencySummary:
+    pipeline: str
+    frames: int
+    p50: dict[str, float]
+    p95: dict[str, float]
+
+
+def latency_summary(rows: Sequence[dict[str, Any]], pipeline: str = MAIN) -> LatencySummary:
+    values: dict[str, list[float]] = defaultdict(list)
+    frames = 0
+    for row in rows:
+        ms = row.get("timing", {}).get("ms", {}).get(pipeline)
+        if not ms:
+            continue
+        frames += len(ms["total"])
+        for stage, column in ms.items():
+            values[stage].extend(v for v in column if v is not None)
+    p50 = {s: float(np.percentile(v, 50)) for s, v in values.items() if v}
+    p95 = {s: float(np.percentile(v, 95)) for s, v in values.items() if v}
+    return LatencySummary(pipeline, frames, p50, p95)
+
+
+# -- everything -----------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SweepMetrics:
+    """All metrics of a results file, per method and per grouping."""
+
+    rows: int
+    families: tuple[str, ...]
+    methods: tuple[str, ...]
+    outcomes: dict[str, list[RunOutcome]]  # per method
+    overall: dict[str, WarningSummary]
+    by_family: dict[str, dict[str, WarningSummary]]  # method -> family -> summary
+    by_case: dict[str, dict[int, WarningSummary]]
+    by_speed: dict[str, dict[float, WarningSummary]]
+    by_scale: dict[str, dict[str, WarningSummary]]
+    cases: dict[str, CaseSummary]
+    positions: dict[str, PositionSummary]
+    phi: dict[str, PhiSummary]
+    found: dict[str, tuple[FoundShare, FoundShare]]
+    latency: dict[str, LatencySummary]
+    seeds: int
+    frame_sizes: tuple[str, ...]
+    machines: tuple[str, ...]
+
+
+def _machine(row: dict[str, Any]) -> str:
+    info = row["timing"]["machine"]
+    return f"{info.get('cpu', '?')} ({info.get('cores', '?')} cores)"
+
+
+def compute(rows: Sequence[dict[str, Any]]) -> SweepMetrics:
+    rows = dedupe(rows)
+    all_methods = methods(rows)
+    outcomes = {m: [judge_run(row, m) for row in rows] for m in all_methods}
+
+    def grouped(key: Callable[[RunOutcome], Any]) -> dict[str, dict[Any, WarningSummary]]:
+        return {
+            m: {g: summarise(m, os) for g, os in group_by(outcomes[m], key).items()}
+            for m in all_methods
+        }
+
+    pipelines = [p for p in (MAIN, ABLATION) if any(p in r["pipelines"] for r in rows)]
+    sizes = sorted(
+        {f"{r['scenario']['camera']['width']}x{r['scenario']['camera']['height']}" for r in rows}
+    )
+    machines = sorted({_machine(r) for r in rows if "machine" in r.get("timing", {})})
+    return SweepMetrics(
+        rows=len(rows),
+        families=tuple(sorted({r["family"] for r in rows})),
+        methods=tuple(all_methods),
+        outcomes=outcomes,
+        overall={m: summarise(m, outcomes[m]) for m in all_methods},
+        by_family=grouped(lambda o: o.family),
+        by_case=grouped(lambda o: o.case),
+        by_speed=grouped(lambda o: round(o.robot_speed, 2)),
+        by_scale=grouped(lambda o: o.scale),
+        cases={m: case_summary(rows, m) for m in all_methods},
+        positions={m: position_summary(rows, m) for m in all_methods},
+        phi={p: phi_summary(rows, p) for p in pipelines},
+        found={p: found_shares(rows, p) for p in pipelines},
+        latency={p: latency_summary(rows, p) for p in pipelines},
+        seeds=len({r["seed"] for r in rows}),
+        frame_sizes=tuple(sizes),
+        machines=tuple(machines),
+    )

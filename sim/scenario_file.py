@@ -1,0 +1,675 @@
+"""Scenario files (scenarios/**/*.toml): load, validate, build Scenarios, sample sweeps.
+
+One format serves a single scenario (the eight cases and standing still) and a family
+(a base scenario plus the parameter ranges a sweep samples, in the spirit of
+OpenSCENARIO's parameter value distributions). scenarios/README.md documents every key.
+Everything is checked when the file is read, and again for every sampled combination:
+a mistake is a UserError naming the file, the dotted field and the bad value, so a sweep
+never dies hours in on a typo.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import tomllib
+import zlib
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from monopic.cases import Case
+from monopic.errors import UserError
+from sim.cases import place_case
+from sim.families import (
+    BODIES,
+    CLOTHING,
+    LIGHTING,
+    SCALES,
+    Crossing,
+    Longitudinal,
+    PlacementError,
+    Scale,
+    Side,
+    Then,
+    crossing_line_x,
+    mannequin,
+    parked_cars_around,
+    place_crossing,
+    place_longitudinal,
+    street_bounds,
+)
+from sim.pedestrian import PedestrianPath
+from sim.road import Occluder, RoadLayout
+from sim.scenario import CameraSpec, Leg, PedestrianSpec, RobotSpec, Scenario, SceneSpec
+
+KINDS = ("case", "collision", "near-miss")
+PATH_KINDS = ("case", "crossing", "longitudinal", "explicit")
+SAMPLING = ("grid", "random")
+MAX_GRID_RUNS = 100_000
+_MISSING: Any = object()
+
+
+class ScenarioFileError(UserError):
+    """One bad value in a scenario file: which file, which field, what value, why."""
+
+    def __init__(self, file: Path | str, field: str, value: object, reason: str) -> None:
+        self.file, self.field, self.value, self.reason = str(file), field, value, reason
+        shown = f" = {_show(value)}" if value is not _MISSING else ""
+        super().__init__(f"{file}: {field}{shown}: {reason}")
+
+
+def _show(value: object) -> str:
+    """A value as the file would spell it (tables inline)."""
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k} = {_show(v)}" for k, v in value.items()) + "}"
+    return repr(value)
+
+
+def _type_name(value: object) -> str:
+    return {bool: "a boolean", int: "an integer", float: "a number", str: "a string"}.get(
+        type(value), "a table" if isinstance(value, dict) else "a list"
+    )
+
+
+class Table:
+    """One TOML table being read: typed getters naming the dotted field; leftovers are unknown."""
+
+    def __init__(self, file: Path, prefix: str, data: Mapping[str, Any]) -> None:
+        self.file, self.prefix, self.data = file, prefix, dict(data)
+        self.seen: set[str] = set()
+
+    def name(self, key: str) -> str:
+        return f"{self.prefix}.{key}" if self.prefix else key
+
+    def error(self, key: str, value: object, reason: str) -> ScenarioFileError:
+        return ScenarioFileError(self.file, self.name(key), value, reason)
+
+    def has(self, key: str) -> bool:
+        return key in self.data
+
+    def raw(self, key: str, default: Any = _MISSING) -> Any:
+        self.seen.add(key)
+        if key not in self.data:
+            if default is _MISSING:
+                raise ScenarioFileError(self.file, self.name(key), _MISSING, "missing (required)")
+            return default
+        return self.data[key]
+
+    def number(
+        self,
+        key: str,
+        default: Any = _MISSING,
+        *,
+        low: float | None = None,
+        high: float | None = None,
+        positive: bool = False,
+        unit: str = "",
+    ) -> float:
+        """A finite float (integers accepted) in [low, high]; `positive` excludes zero."""
+        value = self.raw(key, default)
+        if value is None:
+            return value
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.error(key, value, f"must be a number{_unit(unit)}, not {_type_name(value)}")
+        value = float(value)
+        if not math.isfinite(value):
+            raise self.error(key, value, "must be a finite number")
+        if positive and not value > 0:
+            raise self.error(key, value, f"must be > 0{_unit(unit)}")
+        if low is not None and value < low:
+            raise self.error(key, value, f"must be >= {low:g}{_unit(unit)}")
+        if high is not None and value > high:
+            raise self.error(key, value, f"must be <= {high:g}{_unit(unit)}")
+        return value
+
+    def integer(self, key: str, default: Any = _MISSING, *, low: int = 0, high: int | None = None):
+        value = self.raw(key, default)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise self.error(key, value, f"must be an integer, not {_type_name(value)}")
+        if value < low or (high is not None and value > high):
+            span = f"in [{low}, {high}]" if high is not None else f">= {low}"
+            raise self.error(key, value, f"must be an integer {span}")
+        return value
+
+    def text(self, key: str, default: Any = _MISSING, choices: tuple[str, ...] = ()) -> str:
+        value = self.raw(key, default)
+        if not isinstance(value, str):
+            raise self.error(key, value, f"must be a string, not {_type_name(value)}")
+        if choices and value not in choices:
+            raise self.error(key, value, f"must be one of {', '.join(choices)}")
+        return value
+
+    def flag(self, key: str, default: Any = _MISSING) -> bool:
+        value = self.raw(key, default)
+        if not isinstance(value, bool):
+            raise self.error(key, value, f"must be true or false, not {_type_name(value)}")
+        return value
+
+    def table(self, key: str) -> Table:
+        value = self.raw(key, {})
+        if not isinstance(value, dict):
+            raise self.error(key, value, f"must be a table, not {_type_name(value)}")
+        return Table(self.file, self.name(key), value)
+
+    def tables(self, key: str) -> list[Table]:
+        value = self.raw(key, [])
+        if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
+            raise self.error(key, value, "must be a list of tables ([[...]] or [{...}, ...])")
+        return [Table(self.file, f"{self.name(key)}[{k}]", v) for k, v in enumerate(value)]
+
+    def numbers(self, key: str, default: Any = _MISSING) -> list[float]:
+        value = self.raw(key, default)
+        if not isinstance(value, list):
+            raise self.error(key, value, f"must be a list of numbers, not {_type_name(value)}")
+        out = []
+        for v in value:
+            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
+                raise self.error(key, value, "must be a list of finite numbers")
+            out.append(float(v))
+        return out
+
+    def done(self) -> None:
+        """Reject keys nobody asked for (typos, keys of another path kind)."""
+        for key in self.data:
+            if key not in self.seen:
+                known = ", ".join(sorted(self.seen)) or "none"
+                raise self.error(key, self.data[key], f"unknown key (known here: {known})")
+
+
+def _unit(unit: str) -> str:
+    return f" {unit}" if unit else ""
+
+
+# -- sweeps ---------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Values:
+    """A set of values: a grid axis, or a uniform choice when sampling at random."""
+
+    values: tuple[Any, ...]
+
+    def grid(self) -> tuple[Any, ...]:
+        return self.values
+
+    def sample(self, rng: np.random.Generator) -> Any:
+        return self.values[int(rng.integers(len(self.values)))]
+
+
+@dataclass(frozen=True)
+class Range:
+    """A numeric range: `steps` evenly spaced values, or uniform at random without steps."""
+
+    low: float
+    high: float
+    steps: int | None = None
+
+    def grid(self) -> tuple[float, ...]:
+        if self.steps is None:
+            raise ValueError("a range needs steps in a grid sweep")
+        return tuple(round(float(v), 6) for v in np.linspace(self.low, self.high, self.steps))
+
+    def sample(self, rng: np.random.Generator) -> float:
+        if self.steps is not None:
+            grid = self.grid()
+            return grid[int(rng.integers(len(grid)))]
+        return round(float(rng.uniform(self.low, self.high)), 4)
+
+
+Distribution = Values | Range
+
+
+@dataclass(frozen=True)
+class Sweep:
+    """How a family is sampled: a grid over all parameters, or `runs` seeded random draws."""
+
+    sampling: str
+    parameters: dict[str, Distribution]
+    runs: int = 1
+    seed: int = 0
+
+
+def parse_distribution(table: Table, key: str) -> Distribution:
+    """A parameter distribution: a list of values or {min, max, steps?}."""
+    value = table.raw(key)
+    if isinstance(value, list):
+        if not value:
+            raise table.error(key, value, "needs at least one value")
+        kinds = {type(v) for v in value}
+        if (
+            any(isinstance(v, dict | list) for v in value)
+            or len(kinds - {int, float}) > 1
+            or (kinds & {int, float} and kinds - {int, float})
+        ):
+            raise table.error(key, value, "values must be numbers, strings or booleans of one type")
+        return Values(tuple(value))
+    if isinstance(value, dict):
+        inner = Table(table.file, table.name(key), value)
+        low, high = inner.number("min"), inner.number("max")
+        steps = inner.integer("steps", None, low=1) if inner.has("steps") else None
+        inner.done()
+        if high < low:
+            raise table.error(key, value, "max must be >= min")
+        return Range(low, high, steps)
+    raise table.error(key, value, "must be a list of values or a table {min, max, steps}")
+
+
+def parse_sweep(table: Table) -> Sweep:
+    sampling = table.text("sampling", "grid", SAMPLING)
+    runs = table.integer("runs", 1, low=1)
+    seed = table.integer("seed", 0)
+    params_table = table.table("parameters")
+    parameters = {key: parse_distribution(params_table, key) for key in params_table.data}
+    params_table.seen.update(params_table.data)
+    table.done()
+    if sampling == "grid":
+        for key, dist in parameters.items():
+            if isinstance(dist, Range) and dist.steps is None:
+                raise params_table.error(key, _range_dict(dist), "a range needs steps in a grid")
+    return Sweep(sampling, parameters, runs, seed)
+
+
+def _range_dict(r: Range) -> dict[str, float]:
+    return {"min": r.low, "max": r.high}
+
+
+def expand(sweep: Sweep | None, family: str) -> Iterator[dict[str, Any]]:
+    """The parameter combinations of a sweep (grid order, or seeded random draws).
+
+    Random draws depend only on (seed, family name, draw number), so adding a family to
+    a sweep or reordering files never changes another family's runs.
+    """
+    if sweep is None or not sweep.parameters:
+        yield {}
+        return
+    keys = list(sweep.parameters)
+    if sweep.sampling == "grid":
+        axes = [sweep.parameters[k].grid() for k in keys]
+        total = math.prod(len(a) for a in axes)
+        if total > MAX_GRID_RUNS:
+            raise ValueError(f"a grid of {total} runs is too large (max {MAX_GRID_RUNS})")
+        for combo in _product(axes):
+            yield dict(zip(keys, combo, strict=True))
+        return
+    for k in range(sweep.runs):
+        rng = np.random.default_rng([sweep.seed, _stable_hash(family), k])
+        yield {key: sweep.parameters[key].sample(rng) for key in keys}
+
+
+def _product(axes: list[tuple[Any, ...]]) -> Iterator[tuple[Any, ...]]:
+    if not axes:
+        yield ()
+        return
+    for head in axes[0]:
+        for rest in _product(axes[1:]):
+            yield (head, *rest)
+
+
+def _stable_hash(text: str) -> int:
+    """A process-independent 32-bit hash (Python's hash() is salted per process)."""
+    return zlib.crc32(text.encode())
+
+
+# -- the file -------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class ScenarioFile:
+    """A loaded, validated scenario file: its base scenario and its sweep."""
+
+    path: Path
+    name: str
+    family: str
+    kind: str
+    scale: Scale
+    description: str
+    data: dict[str, Any] = field(repr=False)
+    sweep: Sweep | None
+    base: Scenario
+
+    def scenario(self, params: Mapping[str, Any], name: str, seed: int) -> Scenario:
+        """The scenario with `params` (dotted keys) set; errors name the file and field."""
+        data = with_values(self.data, params)
+        try:
+            scenario = build(self.path, data)
+        except ScenarioFileError as err:
+            if not params:
+                raise
+            shown = ", ".join(f"{k} = {_show(v)}" for k, v in params.items())
+            raise ScenarioFileError(
+                err.file, err.field, err.value, f"{err.reason} (with sweep values {shown})"
+            ) from None
+        return replace(scenario, name=name, seed=seed)
+
+    def runs(self) -> Iterator[dict[str, Any]]:
+        return expand(self.sweep, self.name)
+
+
+def with_values(data: Mapping[str, Any], params: Mapping[str, Any]) -> dict[str, Any]:
+    """A deep copy of a file's data with dotted keys set (tables created as needed)."""
+    out = copy.deepcopy(dict(data))
+    for key, value in params.items():
+        node = out
+        parts = key.split(".")
+        for part in parts[:-1]:
+            node = node.setdefault(part, {})
+            if not isinstance(node, dict):
+                raise ValueError(f"{key}: {part} is not a table")
+        node[parts[-1]] = value
+    return out
+
+
+def load(path: Path | str) -> ScenarioFile:
+    """Read and validate one scenario file (its base scenario and every sweep value)."""
+    path = Path(path)
+    try:
+        with path.open("rb") as fh:
+            data = tomllib.load(fh)
+    except FileNotFoundError:
+        raise UserError(f"{path}: no such scenario file") from None
+    except IsADirectoryError:
+        raise UserError(f"{path}: is a folder, not a scenario file") from None
+    except tomllib.TOMLDecodeError as err:
+        raise UserError(f"{path}: not valid TOML: {err}") from None
+    sweep_data = data.pop("sweep", None)
+    top = Table(path, "", data)
+    name = top.text("name")
+    if not name or any(c.isspace() or c in "/\\" for c in name):
+        raise top.error("name", name, "must be a non-empty name without spaces or slashes")
+    family = top.text("family", name)
+    kind = top.text("kind", "case", KINDS)
+    scale = Scale(top.text("scale", "small", tuple(s.value for s in Scale)))
+    description = top.text("description", "")
+    base = build(path, data)
+    sweep = None
+    if sweep_data is not None:
+        if not isinstance(sweep_data, dict):
+            raise ScenarioFileError(path, "sweep", sweep_data, "must be a table")
+        sweep = parse_sweep(Table(path, "sweep", sweep_data))
+        _check_parameters(path, data, sweep)
+    return ScenarioFile(path, name, family, kind, scale, description, data, sweep, base)
+
+
+def _check_parameters(path: Path, data: dict[str, Any], sweep: Sweep) -> None:
+    """Every value of every parameter must build on its own (type, range, known key)."""
+    for key, dist in sweep.parameters.items():
+        if key.split(".")[0] in ("sweep", "name", "family", "kind", "scale"):
+            raise ScenarioFileError(path, f"sweep.parameters.{key}", _MISSING, "cannot be swept")
+        values = dist.grid() if isinstance(dist, Values) or dist.steps else (dist.low, dist.high)
+        for value in values:
+            try:
+                build(path, with_values(data, {key: value}))
+            except ScenarioFileError as err:
+                if err.field == key or err.reason.startswith("unknown key"):
+                    raise ScenarioFileError(
+                        path, f"sweep.parameters.{key}", value, err.reason
+                    ) from None
+                # Other failures depend on the combination; the sweep checks each run.
+            except ValueError as err:
+                raise ScenarioFileError(path, f"sweep.parameters.{key}", value, str(err)) from None
+
+
+# -- building a Scenario from a file's data -------------------------------------------
+
+
+def build(path: Path, data: Mapping[str, Any]) -> Scenario:
+    """Validate a file's data (without its sweep) and build the Scenario it describes."""
+    top = Table(path, "", data)
+    name = top.text("name")
+    family = top.text("family", name)
+    top.text("kind", "case", KINDS)
+    top.text("description", "")
+    scale = Scale(top.text("scale", "small", tuple(s.value for s in Scale)))
+    preset = SCALES[scale]
+    horizon = top.number("horizon", preset.horizon, positive=True, high=10.0, unit="s")
+    duration = top.number("duration", 4.0, positive=True, high=60.0, unit="s")
+    fps = top.number("fps", 15.0, low=1.0, high=60.0, unit="frames/s")
+    seed = top.integer("seed", 0, high=2**31 - 1)
+    robot = _robot(top.table("robot"), preset.robot)
+    road, lighting = _scene(top.table("scene"), preset.road)
+    ped_table = top.table("pedestrian")
+    body = ped_table.text("body", "adult", BODIES)
+    clothing = ped_table.text("clothing", "default", tuple(CLOTHING))
+    height = ped_table.number("height", None, low=0.8, high=2.2, unit="m")
+    speed = ped_table.number("speed", 1.4, low=0.0, high=10.0, unit="m/s")
+    footprint = ped_table.number("footprint", 0.5, positive=True, high=2.0, unit="m")
+    ped_table.done()
+    looks = mannequin(body, clothing, height)
+    path_table = top.table("path")
+    pedestrian, case, x_line = _path(path_table, robot, road, speed, looks, footprint, duration)
+    occluders = _parked_cars(top.table("scene").table("parked_cars"), x_line, robot, road)
+    top.done()
+    scene = SceneSpec(
+        occluders=occluders, road=road, sun_azimuth_deg=lighting[0], sun_elevation_deg=lighting[1]
+    )
+    scenario = Scenario(
+        name=name,
+        pedestrian=pedestrian,
+        robot=robot,
+        scene=scene,
+        family=family,
+        case=case,
+        duration=duration,
+        dt=1.0 / fps,
+        horizon=horizon,
+        seed=seed,
+    )
+    _check_on_street(path, scenario)
+    return scenario
+
+
+def _robot(t: Table, preset: RobotSpec) -> RobotSpec:
+    max_speed = t.number("max_speed", preset.max_speed, positive=True, high=40.0, unit="m/s")
+    robot = RobotSpec(
+        speed=t.number("speed", preset.speed, low=0.0, high=max_speed, unit="m/s"),
+        width=t.number("width", preset.width, positive=True, high=3.0, unit="m"),
+        length=t.number("length", preset.length, positive=True, high=12.0, unit="m"),
+        camera=_camera(t.table("camera"), preset.camera),
+        max_acceleration=t.number(
+            "max_acceleration", preset.max_acceleration, positive=True, high=15.0, unit="m/s^2"
+        ),
+        max_deceleration=t.number(
+            "max_deceleration", preset.max_deceleration, positive=True, high=15.0, unit="m/s^2"
+        ),
+        max_speed=max_speed,
+    )
+    t.done()
+    return robot
+
+
+def _camera(t: Table, preset: CameraSpec) -> CameraSpec:
+    camera = CameraSpec(
+        width=t.integer("width", preset.width, low=64, high=4096),
+        height=t.integer("height", preset.height, low=64, high=4096),
+        vertical_fov_deg=t.number(
+            "vertical_fov_deg", preset.vertical_fov_deg, low=10.0, high=120.0, unit="degrees"
+        ),
+        mount_height=t.number("mount_height", preset.mount_height, low=0.2, high=4.0, unit="m"),
+        pitch_deg=t.number("pitch_deg", preset.pitch_deg, low=-30.0, high=45.0, unit="degrees"),
+        mount_forward=t.number("mount_forward", preset.mount_forward, low=-5.0, high=5.0, unit="m"),
+    )
+    t.done()
+    return camera
+
+
+def _scene(t: Table, preset: RoadLayout) -> tuple[RoadLayout, tuple[float, float]]:
+    lighting = t.text("lighting", "noon", tuple(LIGHTING))
+    azimuth, elevation = LIGHTING[lighting]
+    azimuth = t.number("sun_azimuth_deg", azimuth, low=-360.0, high=360.0, unit="degrees")
+    elevation = t.number("sun_elevation_deg", elevation, low=2.0, high=90.0, unit="degrees")
+    r = t.table("road")
+    crosswalk = r.flag("crosswalk", preset.crosswalk_x is not None)
+    crosswalk_x = r.number("crosswalk_x", preset.crosswalk_x or 12.0, unit="m")
+    road = RoadLayout(
+        length=r.number("length", preset.length, low=20.0, high=2000.0, unit="m"),
+        lanes=r.integer("lanes", preset.lanes, low=1, high=6),
+        lane_width=r.number("lane_width", preset.lane_width, low=1.5, high=6.0, unit="m"),
+        center_y=r.number("center_y", preset.center_y, low=-20.0, high=20.0, unit="m"),
+        pavement_width=r.number(
+            "pavement_width", preset.pavement_width, low=0.5, high=10.0, unit="m"
+        ),
+        crosswalk_x=crosswalk_x if crosswalk else None,
+        buildings=r.flag("buildings", preset.buildings),
+    )
+    r.done()
+    t.seen.add("parked_cars")  # read by _parked_cars once the path is known
+    t.done()
+    return road, (azimuth, elevation)
+
+
+def _path(
+    t: Table,
+    robot: RobotSpec,
+    road: RoadLayout,
+    speed: float,
+    looks: Any,
+    footprint: float,
+    duration: float,
+) -> tuple[PedestrianSpec, Case | None, float | None]:
+    """The pedestrian's path; also its case and (crossings) the crossing line's x."""
+    kind = t.text("kind", choices=PATH_KINDS)
+    x_line = None
+    try:
+        if kind == "case":
+            pedestrian, case = _case_path(t, robot, speed, looks, footprint, duration)
+        elif kind == "crossing":
+            c = Crossing(
+                side=Side(t.text("side", choices=tuple(s.value for s in Side))),
+                impact_point=t.number("impact_point", low=-5.0, high=6.0),
+                impact_time=t.number("impact_time", positive=True, high=duration, unit="s"),
+                approach=t.number("approach", 4.0, positive=True, high=30.0, unit="m"),
+                then=Then(t.text("then", "walk", tuple(x.value for x in Then))),
+                standstill_distance=t.number("standstill_distance", 4.0, low=0.0, unit="m"),
+            )
+            pedestrian = place_crossing(c, robot, road, speed, looks, footprint)
+            case = Case.PERPENDICULAR_LEFT if c.side is Side.NEAR else Case.PERPENDICULAR_RIGHT
+            x_line = crossing_line_x(robot, footprint, c.impact_time, c.standstill_distance)
+        elif kind == "longitudinal":
+            direction = t.text("direction", "away", ("away", "toward"))
+            c2 = Longitudinal(
+                impact_point=t.number("impact_point", low=-5.0, high=6.0),
+                impact_time=t.number("impact_time", positive=True, high=duration, unit="s"),
+                toward=direction == "toward",
+                standstill_distance=t.number("standstill_distance", 4.0, low=0.0, unit="m"),
+            )
+            if not speed > 0:
+                raise PlacementError("pedestrian.speed", speed, "a walking pedestrian needs > 0")
+            pedestrian = place_longitudinal(c2, robot, speed, looks, footprint)
+            case = Case.TOWARD if c2.toward else Case.AWAY
+        else:
+            leg_tables = t.tables("legs")
+            legs = tuple(
+                Leg(
+                    at=leg.number("at", low=0.0, unit="s"),
+                    speed=leg.number("speed", low=0.0, high=10.0, unit="m/s"),
+                    turn_deg=leg.number("turn_deg", 0.0, low=-360.0, high=360.0, unit="degrees"),
+                )
+                for leg in leg_tables
+            )
+            for leg_table in leg_tables:
+                leg_table.done()
+            pedestrian = PedestrianSpec(
+                x=t.number("x", unit="m"),
+                y=t.number("y", unit="m"),
+                heading_deg=t.number("heading_deg", low=-360.0, high=360.0, unit="degrees"),
+                speed=speed,
+                looks=looks,
+                legs=legs,
+                start_delay=t.number("start_delay", 0.0, low=0.0, unit="s"),
+                footprint=footprint,
+            )
+            case = None
+    except PlacementError as err:
+        raise ScenarioFileError(t.file, err.field, err.value, err.reason) from None
+    t.done()
+    return pedestrian, case, x_line
+
+
+def _case_path(
+    t: Table, robot: RobotSpec, speed: float, looks: Any, footprint: float, duration: float
+) -> tuple[PedestrianSpec, Case]:
+    """sim.cases.place_case semantics: the path passes (distance, offset) at meet_time."""
+    number = t.integer("case", low=1, high=9)
+    case = Case(number)
+    kwargs = dict(
+        distance=t.number("distance", 8.0, low=0.0, high=200.0, unit="m"),
+        lateral_offset=t.number("lateral_offset", 0.0, low=-50.0, high=50.0, unit="m"),
+        angle_deg=t.number("angle_deg", 45.0, unit="degrees"),
+        meet_time=t.number("meet_time", duration / 2, low=0.0, high=duration, unit="s"),
+        facing_deg=t.number("facing_deg", 180.0, low=-360.0, high=360.0, unit="degrees"),
+    )
+    try:
+        scenario = place_case(
+            case, pedestrian_speed=speed, robot_speed=robot.speed, duration=duration,
+            looks=looks, robot=robot, **kwargs,
+        )  # fmt: skip
+    except ValueError as err:
+        # place_case names its parameter in the message: map it back to the file's key.
+        message = str(err)
+        fields = {"walking speed": ("pedestrian.speed", speed)}
+        fields.update({key: (f"path.{key}", value) for key, value in kwargs.items()})
+        field, value = next(
+            (fv for word, fv in fields.items() if word in message), ("path", dict(kwargs))
+        )
+        raise PlacementError(field, value, message) from None
+    return replace(scenario.pedestrian, footprint=footprint), case
+
+
+def _parked_cars(
+    t: Table, x_line: float | None, robot: RobotSpec, road: RoadLayout
+) -> tuple[Occluder, ...]:
+    if not t.data:
+        return ()
+    placement = t.text("placement", choices=("crossing", "fixed"))
+    y = t.number("y", unit="m")
+    if placement == "crossing":
+        gap = t.number("gap", 1.0, positive=True, high=10.0, unit="m")
+        if x_line is None:
+            raise t.error("placement", placement, "needs path.kind = 'crossing'")
+        cars: tuple[Occluder, ...] = parked_cars_around(x_line, y, gap)
+    else:
+        xs = t.numbers("x")
+        if not xs:
+            raise t.error("x", xs, "needs at least one position")
+        cars = tuple(Occluder.parked_car(x, y) for x in xs)
+    t.done()
+    clearance = abs(y) - max(c.width for c in cars) / 2 - robot.width / 2
+    if clearance < 0.1:
+        raise t.error("y", y, "the parked cars would stand in the robot's path")
+    return cars
+
+
+def _check_on_street(path: Path, s: Scenario) -> None:
+    """The robot stays on its road and the pedestrian on the street for the whole run."""
+    road = s.scene.road
+    y_right, y_left = road.edges
+    if not (y_right <= -s.robot.width / 2 and s.robot.width / 2 <= y_left):
+        raise ScenarioFileError(
+            path, "scene.road.center_y", road.center_y, "the robot (at y = 0) is not on the road"
+        )
+    end = s.robot.speed * s.duration + s.robot.length / 2
+    if end > road.length / 2:
+        raise ScenarioFileError(
+            path,
+            "robot.speed",
+            s.robot.speed,
+            f"the robot would drive off the end of the road within the run "
+            f"({end:.1f} m > {road.length / 2:.1f} m): lower the speed or the duration",
+        )
+    x0, x1, y0, y1 = street_bounds(road)
+    ped = PedestrianPath(s.pedestrian)
+    times = [0.0, *ped.breakpoints_between(0.0, s.duration), s.duration]
+    for t in times:
+        x, y = ped.state(t).position
+        if not (x0 <= x <= x1 and y0 <= y <= y1):
+            raise ScenarioFileError(
+                path,
+                "path",
+                {"t": round(t, 3), "x": round(float(x), 2), "y": round(float(y), 2)},
+                f"the pedestrian's path leaves the street (x in [{x0:g}, {x1:g}] m, "
+                f"y in [{y0:.2f}, {y1:.2f}] m)",
+            )

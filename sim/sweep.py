@@ -1,0 +1,245 @@
+"""Sweeps: a SPEC file lists scenario files and how to sample them; runs go to a results file.
+
+A sweep spec (scenarios/sweeps/*.toml, documented in scenarios/README.md):
+
+    name = "demo"
+    ablation = true                 # also run the ground-truth-crop pipeline
+    [[include]]
+    files = ["../families/car/*.toml"]   # globs, relative to the spec
+    sampling = "random"             # "file" (as each file says), "base", "grid", "random"
+    runs = 3                        # random draws per file
+    seed = 7
+    [include.parameters]            # add or replace sweep parameters of those files
+    "robot.speed" = [0.0, 8.33]
+
+Expansion is deterministic: a run's id is the file's name, its draw number and a digest
+of the complete scenario, and its seed derives from the same, so re-expanding the spec
+finds the same runs (resume) and any executor produces the same results.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import sys
+import time
+import zlib
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from tqdm import tqdm
+
+from monopic.errors import UserError
+from sim.results_file import ResultsWriter
+from sim.runner import RunSpec
+from sim.scenario_file import (
+    ScenarioFile,
+    ScenarioFileError,
+    Sweep,
+    Table,
+    expand,
+    load,
+    parse_distribution,
+)
+
+INCLUDE_SAMPLING = ("file", "base", "grid", "random")
+
+
+@dataclass(frozen=True)
+class Include:
+    """One [[include]] entry of a sweep spec."""
+
+    files: tuple[Path, ...]
+    sampling: str = "file"
+    runs: int | None = None
+    seed: int | None = None
+    parameters: dict[str, Any] = field(default_factory=dict)
+
+
+@dataclass(frozen=True)
+class SweepSpec:
+    path: Path
+    name: str
+    description: str
+    ablation: bool
+    includes: tuple[Include, ...]
+
+
+def load_spec(path: Path | str) -> SweepSpec:
+    """Read and check a sweep spec; globs must match scenario files."""
+    import tomllib
+
+    path = Path(path)
+    try:
+        with path.open("rb") as fh:
+            data = tomllib.load(fh)
+    except FileNotFoundError:
+        raise UserError(f"{path}: no such sweep spec") from None
+    except IsADirectoryError:
+        raise UserError(f"{path}: is a folder, not a sweep spec") from None
+    except tomllib.TOMLDecodeError as err:
+        raise UserError(f"{path}: not valid TOML: {err}") from None
+    top = Table(path, "", data)
+    name = top.text("name")
+    description = top.text("description", "")
+    ablation = top.flag("ablation", True)
+    includes = []
+    for entry in top.tables("include"):
+        patterns = entry.raw("files")
+        if (
+            not isinstance(patterns, list)
+            or not patterns
+            or not all(isinstance(p, str) for p in patterns)
+        ):
+            raise entry.error("files", patterns, "must be a non-empty list of glob patterns")
+        files: list[Path] = []
+        for pattern in patterns:
+            matched = sorted(_glob(path.parent, pattern))
+            if not matched:
+                raise entry.error("files", pattern, "matches no scenario file")
+            files.extend(m for m in matched if m not in files)
+        sampling = entry.text("sampling", "file", INCLUDE_SAMPLING)
+        runs = entry.integer("runs", None, low=1) if entry.has("runs") else None
+        seed = entry.integer("seed", None) if entry.has("seed") else None
+        params_table = entry.table("parameters")
+        parameters = {k: parse_distribution(params_table, k) for k in params_table.data}
+        params_table.seen.update(params_table.data)
+        entry.done()
+        includes.append(Include(tuple(files), sampling, runs, seed, parameters))
+    top.done()
+    if not includes:
+        raise ScenarioFileError(path, "include", [], "a sweep needs at least one [[include]]")
+    return SweepSpec(path, name, description, ablation, tuple(includes))
+
+
+def _glob(base: Path, pattern: str) -> list[Path]:
+    if Path(pattern).is_absolute():
+        return [Path(p) for p in sorted(Path("/").glob(pattern.lstrip("/")))]
+    return [p for p in base.glob(pattern) if p.is_file()]
+
+
+def _effective_sweep(include: Include, file: ScenarioFile) -> Sweep | None:
+    """The file's sweep as the include entry modifies it (None: just the base scenario)."""
+    if include.sampling == "base":
+        return None
+    own = file.sweep
+    params = dict(own.parameters) if own else {}
+    params.update(include.parameters)
+    sampling = include.sampling if include.sampling != "file" else (own.sampling if own else "grid")
+    runs = include.runs or (own.runs if own else 1)
+    seed = include.seed if include.seed is not None else (own.seed if own else 0)
+    if sampling == "grid":
+        for key, dist in params.items():
+            if getattr(dist, "steps", 0) is None:
+                raise ScenarioFileError(
+                    file.path, f"sweep.parameters.{key}", key, "a range needs steps in a grid"
+                )
+    return Sweep(sampling, params, runs, seed)
+
+
+def run_id(file: ScenarioFile, index: int, digest: str) -> str:
+    return f"{file.name}/{index:04d}-{digest}"
+
+
+def expand_spec(spec: SweepSpec) -> list[RunSpec]:
+    """Every run of the sweep, validated, in a stable order (duplicates dropped)."""
+    runs: list[RunSpec] = []
+    seen: set[str] = set()
+    for include in spec.includes:
+        for path in include.files:
+            file = load(path)
+            sweep = _effective_sweep(include, file)
+            try:
+                combos = list(expand(sweep, file.name))
+            except ValueError as err:
+                raise ScenarioFileError(path, "sweep", include.sampling, str(err)) from None
+            for index, params in enumerate(combos):
+                probe = file.scenario(params, name=file.name, seed=0)
+                digest = hashlib.sha1(repr(probe).encode()).hexdigest()[:8]
+                rid = run_id(file, index, digest)
+                if rid in seen:
+                    continue
+                seen.add(rid)
+                seed = (file.base.seed + zlib.crc32(f"{file.name}:{digest}".encode())) % 2**31
+                runs.append(
+                    RunSpec(
+                        id=rid,
+                        scenario=replace(probe, name=rid, seed=seed),
+                        family=file.family,
+                        file=str(path),
+                        kind=file.kind,
+                        scale=file.scale.value,
+                        params={k: _plain(v) for k, v in params.items()},
+                        sweep=spec.name,
+                        ablation=spec.ablation,
+                    )
+                )
+    return runs
+
+
+def _plain(value: Any) -> Any:
+    return json.loads(json.dumps(value))
+
+
+@dataclass(frozen=True)
+class SweepOutcome:
+    total: int
+    skipped: int  # already in the results file
+    finished: int  # run now and appended
+    failed: tuple[tuple[str, str], ...]  # (run id, error)
+    seconds: float
+
+
+Executor = Callable[[Sequence[RunSpec], Callable[[dict[str, Any]], None]], None]
+
+
+def run_sweep(
+    spec: SweepSpec,
+    out: Path,
+    executor: Executor,
+    ablation: bool | None = None,
+    progress: bool = True,
+    limit: int | None = None,
+) -> SweepOutcome:
+    """Run every run of `spec` missing from `out`, appending each result as it finishes.
+
+    `ablation` overrides the spec's flag; `limit` stops after that many new runs (to
+    measure a rate, or to test resuming).
+    """
+    runs = expand_spec(spec)
+    if ablation is not None:
+        runs = [replace(r, ablation=ablation) for r in runs]
+    if not out.parent.is_dir():
+        raise UserError(f"{out}: its folder {out.parent} does not exist")
+    with ResultsWriter(out) as writer:
+        state = writer.state
+        todo = [r for r in runs if r.id not in state.ids]
+        skipped = len(runs) - len(todo)
+        if limit is not None:
+            todo = todo[:limit]
+        failed: list[tuple[str, str]] = []
+        finished = 0
+        start = time.perf_counter()
+        if skipped and progress:
+            print(f"{out}: {skipped} of {len(runs)} runs already there, running the other "
+                  f"{len(todo)}", file=sys.stderr)  # fmt: skip
+        bar = tqdm(
+            total=len(todo), unit="run", desc=spec.name, disable=not progress, dynamic_ncols=True
+        )
+        with bar:
+
+            def on_result(row: dict[str, Any]) -> None:
+                nonlocal finished
+                if "error" in row:
+                    failed.append((row["id"], row["error"]))
+                    bar.write(f"run {row['id']} failed: {row['error'].strip().splitlines()[-1]}")
+                else:
+                    writer.append(row)
+                    finished += 1
+                bar.update(1)
+
+            if todo:
+                executor(todo, on_result)
+    return SweepOutcome(len(runs), skipped, finished, tuple(failed), time.perf_counter() - start)

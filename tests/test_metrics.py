@@ -1,0 +1,207 @@
+"""Metrics on hand-made result rows whose answers are known by construction."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from sim.metrics import (
+    available_times,
+    case_summary,
+    compute,
+    judge_run,
+    position_summary,
+    summarise,
+    wilson,
+)
+from sim.report import write_report
+
+DT = 0.1
+KEY = "rules/image"
+
+
+def row(
+    run_id: str,
+    ttc: list[float | None],
+    warn: list[int | None],
+    *,
+    horizon: float = 0.5,
+    kind: str = "collision",
+    family: str = "fam",
+    scale: str = "small",
+    case: list[int] | None = None,
+    pred_case: list[int | None] | None = None,
+    pose_ms: float = 10.0,
+    robot_speed: float = 2.0,
+) -> dict[str, Any]:
+    """A result line in the runner's schema with only what the metrics read."""
+    n = len(ttc)
+    t = [round(k * DT, 4) for k in range(n)]
+    foot = [[100.0 + 10 * k, 200.0] for k in range(n)]
+    decisions = {
+        KEY: {
+            "warn": warn,
+            "case": pred_case or [5 if w is not None else None for w in warn],
+            # The prediction at k is the true foot 5 frames (the horizon) later + (3, 4) px.
+            "foot": [
+                [100.0 + 10 * (k + 5) + 3, 204.0] if warn[k] is not None else None for k in range(n)
+            ],  # fmt: skip
+            "ground": [None] * n,
+            "ttc": [None] * n,
+        }
+    }
+    return {
+        "schema": 1,
+        "id": run_id,
+        "family": family,
+        "kind": kind,
+        "scale": scale,
+        "seed": 1,
+        "params": {},
+        "scenario": {
+            "case": None,
+            "robot_speed": robot_speed,
+            "horizon": horizon,
+            "dt": DT,
+            "camera": {"width": 320, "height": 180},
+        },
+        "truth": {
+            "t": t,
+            "ttc": ttc,
+            "collision": [int(c is not None and c <= horizon) for c in ttc],
+            "case": case or [5] * n,
+            "phi": [0.0] * n,
+            "range": [5.0] * n,
+            "height": [100.0] * n,
+            "in_frame": [1] * n,
+            "visible": [1.0] * n,
+            "foot": foot,
+            "future": [[1.0, 0.0]] * n,
+        },
+        "pipelines": {
+            "main": {"found": [1] * n, "phi": [10.0] * n, "decisions": decisions},
+        },
+        "timing": {
+            "ms": {
+                "main": {
+                    "pose": [pose_ms] * n,
+                    "features": [0.0] * n,
+                    "predict": [0.0] * n,
+                    "warning": [0.0] * n,
+                    "total": [pose_ms] * n,
+                }
+            },
+            "machine": {"cpu": "test", "cores": 1},
+        },
+    }
+
+
+def collision_row(run_id: str, first_warning: int | None, **kw: Any) -> dict[str, Any]:
+    """20 frames, contact at t = 2.0 s; warnings from frame `first_warning` on."""
+    ttc = [round(2.0 - k * DT, 4) for k in range(20)]
+    warn = [int(first_warning is not None and k >= first_warning) for k in range(20)]
+    return row(run_id, ttc, warn, **kw)
+
+
+def near_miss_row(run_id: str, warn_frames: set[int]) -> dict[str, Any]:
+    return row(run_id, [None] * 20, [int(k in warn_frames) for k in range(20)], kind="near-miss")
+
+
+def test_wilson_lower_bound_known_values() -> None:
+    assert wilson(10, 10)[0] == pytest.approx(10 / (10 + 1.959964**2), abs=1e-6)  # 0.7225
+    assert wilson(73, 73)[0] == pytest.approx(0.950, abs=1e-3)  # the goal needs n >= 73
+    assert wilson(1, 2)[0] == pytest.approx(0.0945, abs=1e-4)
+    assert wilson(0, 5)[0] == 0.0
+    assert all(math.isnan(v) for v in wilson(0, 0))
+
+
+def test_frame_counts_recall_precision_and_false_alarms() -> None:
+    # Run A: positive frames 15-19 (TTC <= 0.5 s); warns from frame 9: TP 5, FP 6, TN 9.
+    a = judge_run(collision_row("a", 9), KEY)
+    assert (a.frames.tp, a.frames.fp, a.frames.fn, a.frames.tn) == (5, 6, 0, 9)
+    # Run B never warns: FN 5, TN 15. Near miss C warns once: FP 1, TN 19.
+    b = judge_run(collision_row("b", None), KEY)
+    c = judge_run(near_miss_row("c", {4}), KEY)
+    s = summarise(KEY, [a, b, c])
+    assert (s.frames.tp, s.frames.fp, s.frames.fn, s.frames.tn) == (5, 7, 5, 43)
+    assert s.frames.recall == pytest.approx(0.5)
+    assert s.frames.precision == pytest.approx(5 / 12)
+    assert s.frames.false_alarm_rate == pytest.approx(7 / 50)
+
+
+def test_run_recall_lead_time_and_near_misses() -> None:
+    a = judge_run(collision_row("a", 9), KEY)  # onset t = 0.9, contact 2.0: lead 1.1 s
+    b = judge_run(collision_row("b", 17), KEY)  # onset 1.7: lead 0.3 s
+    c = judge_run(collision_row("c", None), KEY)
+    d = judge_run(near_miss_row("d", {4}), KEY)
+    e = judge_run(near_miss_row("e", set()), KEY)
+    assert a.contact_time == pytest.approx(2.0) and a.lead == pytest.approx(1.1)
+    assert b.lead == pytest.approx(0.3) and c.lead is None
+    s = summarise(KEY, [a, b, c, d, e])
+    assert (s.collision_runs, s.warned, s.warned_1s, s.timely) == (3, 2, 1, 0)
+    assert s.recall == pytest.approx(2 / 3)
+    assert s.recall_low == pytest.approx(wilson(2, 3)[0])
+    assert s.recall_1s == pytest.approx(1 / 3)
+    assert (s.near_miss_runs, s.near_miss_warned) == (2, 1)
+    assert s.near_miss_warned_share == pytest.approx(0.5)
+    assert s.lead_p50 == pytest.approx(0.7)
+    assert not s.meets_goal
+
+
+def test_latency_applied_recall_skips_frames_while_busy() -> None:
+    """150 ms per frame at 10 frames/s: every other frame is processed, 150 ms late."""
+    r = collision_row("a", 9, pose_ms=150.0)
+    avail = available_times(r, "main")
+    assert avail[0] == pytest.approx(0.15) and avail[1] is None
+    assert avail[2] == pytest.approx(0.35) and avail[3] is None
+    out = judge_run(r, KEY)
+    # Frame 9 warned but was skipped; frame 10's warning exists at 1.15 s: lead 0.85 s.
+    assert out.onset == pytest.approx(0.9)
+    assert out.onset_latency == pytest.approx(1.15)
+    assert out.lead_latency == pytest.approx(0.85)
+    s = summarise(KEY, [out])
+    assert (s.warned_1s, s.warned_latency, s.warned_1s_latency) == (1, 1, 0)
+
+
+def test_a_warning_produced_after_contact_does_not_count() -> None:
+    r = collision_row("a", 19, pose_ms=250.0)  # frame 18 processed, 19 skipped
+    assert judge_run(r, KEY).onset == pytest.approx(1.9)
+    assert judge_run(r, KEY).lead_latency is None
+
+
+def test_case_accuracy_confusion_and_position_error() -> None:
+    warn: list[int | None] = [0] * 10 + [None] * 2
+    pred: list[int | None] = [5] * 6 + [6] * 4 + [None] * 2
+    r = row("a", [None] * 12, warn, pred_case=pred)
+    cases = case_summary([r], KEY)
+    assert cases.frames == 10 and cases.accuracy == pytest.approx(0.6)
+    assert cases.confusion[4, 4] == 6 and cases.confusion[4, 5] == 4
+    positions = position_summary([r], KEY)
+    # Horizon 0.5 s = 5 frames: frames 0-6 have a true foot 5 frames later; error (3, 4).
+    assert len(positions.px) == 7 and positions.px_percentile(50) == pytest.approx(5.0)
+    acc = positions.accuracy_within([0, 4, 5, 10])
+    assert list(acc) == [0.0, 0.0, 1.0, 1.0]
+
+
+def test_compute_groups_and_report_files(tmp_path: Path) -> None:
+    rows = [
+        collision_row("a", 9, family="f1", robot_speed=1.0),
+        collision_row("b", None, family="f1", robot_speed=2.0),
+        collision_row("c", 2, family="f2", scale="car", robot_speed=2.0),
+        near_miss_row("d", {3}),
+        collision_row("a", None, family="f1"),  # a duplicate id: counted once
+    ]
+    m = compute(rows)
+    assert m.rows == 4 and m.methods == (KEY,)
+    fam = m.by_family[KEY]
+    assert (fam["f1"].collision_runs, fam["f1"].warned) == (2, 1)
+    assert m.by_speed[KEY][2.0].collision_runs == 2
+    assert m.by_scale[KEY]["car"].timely == 1  # lead 1.8 s >= 1.7 s
+    report = write_report(m, rows, tmp_path / "r.jsonl", tmp_path / "rep")
+    assert report.markdown.read_text().startswith("# Sweep report")
+    pngs = sorted(p.name for p in (tmp_path / "rep").glob("*.png"))
+    assert sorted(p.name for p in report.plots) == pngs and len(pngs) == 7
+    assert "rules/image" in report.headline

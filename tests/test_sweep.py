@@ -1,0 +1,171 @@
+"""Sweeps end to end on tiny runs: results lines, resume after a stop or a torn line,
+identical results on Ray, and the two commands."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from monopic.cli.main import main
+from monopic.errors import UserError
+from sim.executors import local_executor, ray_executor, ray_runtime_env
+from sim.results_file import ResultsWriter, read_rows, scan
+from sim.runner import deterministic_part
+from sim.sweep import expand_spec, load_spec, run_sweep
+
+# A 6-frame crossing on a 256x144 camera without buildings: seconds per run.
+SCENARIO = """
+name = "tiny"
+kind = "collision"
+scale = "small"
+duration = 0.4
+fps = 15
+[robot]
+speed = 2.0
+[robot.camera]
+width = 256
+height = 144
+[pedestrian]
+speed = 1.4
+[path]
+kind = "case"
+case = 5
+distance = 3.0
+[scene.road]
+buildings = false
+crosswalk = false
+[sweep]
+sampling = "grid"
+[sweep.parameters]
+"robot.speed" = [0.0, 1.0, 2.0]
+"""
+SPEC = """
+name = "tiny"
+ablation = {ablation}
+[[include]]
+files = ["tiny.toml"]
+"""
+
+
+@pytest.fixture()
+def spec_path(tmp_path: Path) -> Path:
+    (tmp_path / "tiny.toml").write_text(SCENARIO)
+    path = tmp_path / "spec.toml"
+    path.write_text(SPEC.format(ablation="true"))
+    return path
+
+
+def by_id(path: Path) -> dict[str, dict]:
+    rows = list(read_rows(path))
+    assert len({r["id"] for r in rows}) == len(rows), "duplicate run ids"
+    return {r["id"]: deterministic_part(r) for r in rows}
+
+
+def test_results_file_ignores_a_torn_tail_and_rejects_a_bad_middle(tmp_path: Path) -> None:
+    path = tmp_path / "r.jsonl"
+    path.write_bytes(b'{"id": "a"}\n{"id": "b"}\n{"id": "c", "trun')
+    state = scan(path)
+    assert state.ids == {"a", "b"} and state.torn
+    with ResultsWriter(path) as writer:
+        assert writer.state == state
+        with pytest.raises(UserError, match="another sweep is writing to it"):
+            ResultsWriter(path)
+        writer.append({"id": "d"})
+    assert path.read_bytes() == b'{"id": "a"}\n{"id": "b"}\n{"id":"d"}\n'
+    assert not scan(path).torn
+    path.write_bytes(b'{"id": "a"}\nnot json\n{"id": "b"}\n')
+    with pytest.raises(UserError, match=r"r.jsonl:2: not a result line"):
+        scan(path)
+
+
+@pytest.mark.slow
+def test_sweep_writes_one_line_per_run_and_resumes_without_loss(
+    spec_path: Path, tmp_path: Path
+) -> None:
+    spec = load_spec(spec_path)
+    ids = [r.id for r in expand_spec(spec)]
+    assert len(ids) == 3
+    out = tmp_path / "results.jsonl"
+    executor = local_executor(2)
+
+    # Stopped after one run (as if interrupted): one complete line.
+    first = run_sweep(spec, out, executor, progress=False, limit=1)
+    assert (first.finished, first.skipped) == (1, 0)
+    assert len(out.read_text().splitlines()) == 1
+
+    # Resumed: the other two, nothing twice.
+    second = run_sweep(spec, out, executor, progress=False)
+    assert (second.finished, second.skipped, second.total) == (2, 1, 3)
+    rows = by_id(out)
+    assert sorted(rows) == sorted(ids)
+
+    # A torn last line (killed mid-write) is dropped and its run done again, identically.
+    lines = out.read_bytes().splitlines(keepends=True)
+    last = json.loads(lines[-1])
+    out.write_bytes(b"".join(lines[:-1]) + lines[-1][: len(lines[-1]) // 2])
+    third = run_sweep(spec, out, executor, progress=False)
+    assert (third.finished, third.skipped) == (1, 2)
+    again = by_id(out)
+    assert sorted(again) == sorted(ids)
+    assert again[last["id"]] == deterministic_part(last)  # deterministic per run
+
+    # Every line holds both pipelines side by side with the truth, frame for frame.
+    row = next(iter(read_rows(out)))
+    assert set(row["pipelines"]) == {"main", "gtcrop"}
+    n = row["frames"]
+    assert len(row["truth"]["t"]) == n
+    for cols in row["pipelines"]["main"]["decisions"].values():
+        assert all(len(v) == n for v in cols.values())
+
+
+@pytest.mark.slow
+def test_ray_executor_gives_the_local_executor_results(tmp_path: Path) -> None:
+    ray = pytest.importorskip("ray", reason="Ray is not installed (the optional [ray] extra)")
+    (tmp_path / "tiny.toml").write_text(SCENARIO)
+    spec_path = tmp_path / "spec.toml"
+    spec_path.write_text(SPEC.format(ablation="false"))
+    spec = load_spec(spec_path)
+    local_out, ray_out = tmp_path / "local.jsonl", tmp_path / "ray.jsonl"
+    run_sweep(spec, local_out, local_executor(2), progress=False)
+    ray.init(num_cpus=2, include_dashboard=False, runtime_env=ray_runtime_env())
+    try:
+        outcome = run_sweep(spec, ray_out, ray_executor(None), progress=False)
+    finally:
+        ray.shutdown()
+    assert outcome.finished == 3 and not outcome.failed
+    assert by_id(ray_out) == by_id(local_out)
+
+
+@pytest.mark.slow
+def test_sweep_and_report_commands(
+    spec_path: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "cli.jsonl"
+    assert main(["sweep", str(spec_path), "--out", str(out), "--dry-run"]) == 0
+    assert "3 runs in 1 families, 0 already" in capsys.readouterr().out
+    code = main(["sweep", str(spec_path), "--out", str(out), "--workers", "2", "--no-ablation"])
+    assert code == 0
+    assert len(out.read_text().splitlines()) == 3
+    assert all("gtcrop" not in r["pipelines"] for r in read_rows(out))
+    report_dir = tmp_path / "report"
+    assert main(["report", str(out), "--out", str(report_dir)]) == 0
+    printed = capsys.readouterr().out
+    assert "rules/image" in printed and "report.md" in printed
+    assert (report_dir / "report.md").is_file()
+    assert len(list(report_dir.glob("*.png"))) == 7
+
+
+def test_bad_spec_and_results_are_one_line_errors(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    spec = tmp_path / "spec.toml"
+    spec.write_text('name = "x"\n[[include]]\nfiles = ["nothing*.toml"]\n')
+    assert main(["sweep", str(spec), "--dry-run"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert err.endswith("include[0].files = 'nothing*.toml': matches no scenario file")
+    assert "\n" not in err
+    assert main(["report", str(tmp_path / "none.jsonl")]) == 2
+    assert "no such results file" in capsys.readouterr().err
+    assert main(["sweep", str(spec), "--address", "h:1"]) == 2
