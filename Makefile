@@ -40,3 +40,4 @@ clean-venv:
 	rm -rf $(VENV)
 
 -include Makefile.models
+-include bench/Makefile.bench

@@ -1,0 +1,180 @@
+"""The frames both pipelines see in the reference comparison, decoded or rendered once.
+
+Two sources, all 768x432 RGB: the shipped clip (tests/data/walk_clip.mp4, decoded, with
+its truth CSV) and short World clips of a few cases at several distances (robot standing,
+so the distance holds). They are stored as one uint8 array (N, H, W, 3) in a .npy file
+that workers memory-map (no copy per process), and a .npz with the truth: landmark pixels
+(N, 33, 2), a visibility mask (N, 33) (in the image and, for rendered frames, not
+occluded; the clip's CSV has no occlusion, so there it is "in the image"), sequence
+number and timestamp per frame. A sequence is a run of consecutive frames: trackers are
+reset at each sequence start.
+
+    .venv/bin/python bench/frameset.py [--out recordings/bench/frames]
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import hashlib
+import json
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+ROOT = Path(__file__).resolve().parents[1]
+CLIP = ROOT / "tests" / "data" / "walk_clip.mp4"
+CLIP_TRUTH = ROOT / "tests" / "data" / "walk_clip_truth.csv"
+DEFAULT_DIR = ROOT / "recordings" / "bench"
+NUM_LANDMARKS = 33
+# Rendered clips: (case number, distance in m); frames per clip at 15 fps.
+RENDERED_CASES = (5, 7, 3, 9)
+RENDERED_DISTANCES = (3.0, 6.0, 10.0)
+RENDERED_FRAMES = 16
+
+
+@dataclass(frozen=True)
+class FrameSet:
+    """Memory-mapped frames plus their truth; `sequences[k]` names sequence k."""
+
+    images: np.ndarray  # (N, H, W, 3) uint8, memory-mapped read-only
+    landmarks: np.ndarray  # (N, 33, 2) true pixels, NaN where unknown
+    visible: np.ndarray  # (N, 33) bool
+    sequence: np.ndarray  # (N,) int
+    timestamp: np.ndarray  # (N,) s
+    sequences: list[str]
+    distance: np.ndarray  # (N,) m to the pedestrian's path crossing; NaN for the clip
+
+    def __len__(self) -> int:
+        return len(self.sequence)
+
+
+def spec_digest() -> str:
+    """Changes when the frame recipe changes, so a stale cache is rebuilt."""
+    recipe = json.dumps(
+        [CLIP.stat().st_size, RENDERED_CASES, RENDERED_DISTANCES, RENDERED_FRAMES, 1]
+    )
+    return hashlib.sha1(recipe.encode()).hexdigest()[:10]
+
+
+def paths(directory: Path) -> tuple[Path, Path]:
+    d = spec_digest()
+    return directory / f"frames-{d}.npy", directory / f"frames-{d}.npz"
+
+
+def _clip_frames() -> tuple[list[np.ndarray], np.ndarray, np.ndarray, np.ndarray]:
+    from monopic.video import VideoSource
+
+    frames = list(VideoSource(str(CLIP)))
+    with CLIP_TRUTH.open() as fh:
+        rows = list(csv.DictReader(fh))
+    if len(rows) != len(frames):
+        raise RuntimeError(f"{CLIP_TRUTH}: {len(rows)} rows for {len(frames)} frames")
+    lm = np.array(
+        [[[float(r[f"lm{i}_u"]), float(r[f"lm{i}_v"])] for i in range(NUM_LANDMARKS)] for r in rows]
+    )
+    h, w = frames[0].image.shape[:2]
+    vis = (lm[..., 0] >= 0) & (lm[..., 0] < w) & (lm[..., 1] >= 0) & (lm[..., 1] < h)
+    return [f.image for f in frames], lm, vis, np.array([f.timestamp for f in frames])
+
+
+def _rendered(case: int, distance: float, frames: int):
+    """One World clip: images, true pixels, visibility mask, timestamps."""
+    from dataclasses import replace
+
+    from monopic.cases import Case
+    from sim.cases import place_case
+    from sim.ground_truth import in_image
+    from sim.world import World
+
+    duration = frames / 15.0
+    sc = place_case(
+        Case(case),
+        distance=distance,
+        robot_speed=0.0,
+        duration=duration,
+        meet_time=duration / 2,
+        seed=int(distance * 10) + case,
+    )
+    sc = replace(sc, name=f"case{case}@{distance:g}m")
+    images, lms, vis, ts = [], [], [], []
+    with World(sc) as world:
+        for step in world.run():
+            assert step.frame is not None
+            images.append(step.frame.image)
+            px = step.truth.landmarks_px
+            lms.append(px)
+            vis.append(in_image(world.camera, px) & ~step.truth.landmarks_occluded)
+            ts.append(step.time)
+    return images, np.array(lms), np.array(vis), np.array(ts), sc.name
+
+
+def build(directory: Path = DEFAULT_DIR) -> tuple[Path, Path]:
+    """Decode and render the frame set unless the cache already has it; return its paths."""
+    npy, npz = paths(directory)
+    if npy.is_file() and npz.is_file():
+        return npy, npz
+    directory.mkdir(parents=True, exist_ok=True)
+    images, lms, vis, seq, ts, dist, names = [], [], [], [], [], [], []
+    im, lm, v, t = _clip_frames()
+    images += im
+    lms.append(lm)
+    vis.append(v)
+    ts.append(t)
+    seq += [0] * len(im)
+    dist += [float("nan")] * len(im)
+    names.append("walk_clip")
+    for case in RENDERED_CASES:
+        for distance in RENDERED_DISTANCES:
+            im, lm, v, t, name = _rendered(case, distance, RENDERED_FRAMES)
+            images += im
+            lms.append(lm)
+            vis.append(v)
+            ts.append(t)
+            seq += [len(names)] * len(im)
+            dist += [distance] * len(im)
+            names.append(name)
+            print(f"rendered {name}", file=sys.stderr)
+    tmp = npy.with_suffix(".tmp.npy")
+    np.save(tmp, np.stack(images))
+    np.savez(
+        npz,
+        landmarks=np.concatenate(lms),
+        visible=np.concatenate(vis),
+        sequence=np.array(seq),
+        timestamp=np.concatenate(ts),
+        distance=np.array(dist),
+        names=np.array(names),
+    )
+    tmp.rename(npy)
+    return npy, npz
+
+
+def load(npy: Path, npz: Path) -> FrameSet:
+    """Memory-map the images (shared page cache between processes) and read the truth."""
+    images = np.load(npy, mmap_mode="r")
+    with np.load(npz) as z:
+        return FrameSet(
+            images=images,
+            landmarks=z["landmarks"],
+            visible=z["visible"].astype(bool),
+            sequence=z["sequence"],
+            timestamp=z["timestamp"],
+            sequences=[str(n) for n in z["names"]],
+            distance=z["distance"],
+        )
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--out", type=Path, default=DEFAULT_DIR)
+    args = ap.parse_args()
+    npy, npz = build(args.out)
+    fs = load(npy, npz)
+    print(f"{npy}: {len(fs)} frames, {len(fs.sequences)} sequences, {fs.images.shape}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,187 @@
+"""The stage after pose: time per frame (µs) and operation count, beside the paper's 8 ms / 23.
+
+Poses are recorded once by running our tracker over the benchmark frame set
+(bench/frameset.py); then the stage after pose (features: facing angle, Kalman, image
+velocity, foot point, ground motion; each predictor; warning; path projection) is
+replayed over those poses many times, a fresh FeatureExtractor per sequence, exactly as
+Pipeline.process runs it. One onnxruntime-free, single-threaded Python loop: the
+thread count does not matter here. Operation counts come from monopic/tree/opcount.py:
+the worst case over inputs and the mean over the recorded frames.
+
+    .venv/bin/python bench/post_pose.py [--repeats 30] [--no-append]
+"""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+
+from monopic.features.extractor import FeatureExtractor
+from monopic.frame import EgoState
+from monopic.pose.tracker import PoseTracker, TrackerConfig
+from monopic.predict.base import Mode
+from monopic.predictors import make_predictor
+from monopic.tree.model import TreePredictor
+from monopic.tree.opcount import (
+    PAPER_CALCULATIONS_PER_PREDICTION,
+    mean_prediction_ops,
+    prediction_ops,
+    stage_ops,
+    worst_case_prediction_ops,
+)
+from monopic.variants.path import project_path
+from monopic.variants.warning import CollisionWarning
+from sim.scenario import CameraSpec
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from common import append_section  # noqa: E402
+from frameset import build, load  # noqa: E402
+
+PAPER_TREE_MS = 8.0
+HORIZON = 1.0
+# (label, predictors, with robot state): the paper's image-mode predictors alone, then
+# the set every simulator run evaluates side by side (sim/runner.py PREDICTORS).
+SETS = (
+    ("rules, image (the reference cascade)", (("rules", Mode.IMAGE),), False),
+    ("ID3 tree, image", (("tree", Mode.IMAGE),), False),
+    (
+        "runner set: rules, tree, const-vel image + rules, const-vel ground",
+        (
+            ("rules", Mode.IMAGE),
+            ("tree", Mode.IMAGE),
+            ("constant-velocity", Mode.IMAGE),
+            ("rules", Mode.GROUND),
+            ("constant-velocity", Mode.GROUND),
+        ),
+        True,
+    ),
+)
+
+
+def record_poses(fs) -> list:
+    """Our tracker's pose (or None) on every frame, trackers reset per sequence."""
+    tracker = PoseTracker(TrackerConfig(threads=1))
+    poses = []
+    for i in range(len(fs)):
+        if i == 0 or fs.sequence[i] != fs.sequence[i - 1]:
+            tracker.reset()
+        poses.append(tracker.process(np.array(fs.images[i])).pose)
+    return poses
+
+
+def replay(fs, poses, predictors, ego, size) -> dict[str, float]:
+    """One pass of the stage after pose over all frames; seconds per part."""
+    w, h = size
+    warning = CollisionWarning()
+    parts = {"features": 0.0, "predict": 0.0, "warning + path": 0.0}
+    extractor = FeatureExtractor()
+    clock = time.perf_counter
+    for i, pose in enumerate(poses):
+        if i == 0 or fs.sequence[i] != fs.sequence[i - 1]:
+            extractor = FeatureExtractor()
+        t0 = clock()
+        feats = extractor.update(float(fs.timestamp[i]), pose, h, ego)
+        t1 = clock()
+        parts["features"] += t1 - t0
+        if feats is None:
+            continue
+        for p in predictors:
+            if p.mode is Mode.GROUND and feats.ground is None:
+                continue
+            t1 = clock()
+            pred = p.predict(feats, HORIZON)
+            t2 = clock()
+            wn = warning.assess(feats, pred, p.mode, (w, h), ego)
+            project_path(feats, pred, wn.zone)
+            t3 = clock()
+            parts["predict"] += t2 - t1
+            parts["warning + path"] += t3 - t2
+    return parts
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--repeats", type=int, default=30, help="timed passes per predictor set")
+    ap.add_argument("--no-append", action="store_true")
+    args = ap.parse_args()
+    npy, npz = build()
+    fs = load(npy, npz)
+    n = len(fs)
+    h, w = fs.images.shape[1:3]
+    poses = record_poses(fs)
+    found = sum(p is not None for p in poses)
+    camera = CameraSpec(width=w, height=h).model()
+    ego_still = EgoState(camera, 0.0, 0.0)
+
+    lines = [
+        f"{n} frames ({found} with a pose; poses recorded once by our tracker) of the "
+        f"benchmark frame set, {args.repeats} timed passes after 3 warm-up passes; "
+        "time per frame = per-pass sum / frames, median over passes (and the spread "
+        "between the fastest and slowest pass). Paper: 8 ms for the tree stage on an "
+        "i5-7200U.",
+        "",
+        "| stage after pose | features | predict | warning + path | total per frame "
+        "| pass spread | vs paper's 8 ms |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for label, names, with_ego in SETS:
+        predictors = [make_predictor(name, mode) for name, mode in names]
+        ego = ego_still if with_ego else None
+        for _ in range(3):
+            replay(fs, poses, predictors, ego, (w, h))
+        passes = [replay(fs, poses, predictors, ego, (w, h)) for _ in range(args.repeats)]
+        per = {k: float(np.median([p[k] for p in passes])) * 1e6 / n for k in passes[0]}
+        totals = [sum(p.values()) * 1e6 / n for p in passes]
+        total = float(np.median(totals))
+        spread = (max(totals) - min(totals)) / total
+        lines.append(
+            f"| {label} | {per['features']:.1f} µs | {per['predict']:.1f} µs "
+            f"| {per['warning + path']:.1f} µs | {total:.1f} µs | {100 * spread:.0f} % "
+            f"| {PAPER_TREE_MS * 1e3 / total:.0f}x faster |"
+        )
+
+    tree = make_predictor("tree", Mode.IMAGE)
+    assert isinstance(tree, TreePredictor)
+    feats = []
+    extractor = FeatureExtractor()
+    for i, pose in enumerate(poses):
+        if i == 0 or fs.sequence[i] != fs.sequence[i - 1]:
+            extractor = FeatureExtractor()
+        f = extractor.update(float(fs.timestamp[i]), pose, h)
+        if f is not None:
+            feats.append(f)
+    worst = worst_case_prediction_ops(tree)
+    mean, lo, hi = mean_prediction_ops(tree, feats, HORIZON)
+    stage_mean = float(
+        np.mean([stage_ops(prediction_ops(tree, f, HORIZON)).total.total for f in feats])
+    )
+    stage_worst = stage_ops(worst).total
+    lines += [
+        "",
+        f"Operation counts of the ID3 tree in image mode (monopic/tree/opcount.py; paper: "
+        f"{PAPER_CALCULATIONS_PER_PREDICTION} calculations per prediction):",
+        "",
+        "| count | one prediction (bins + tree + placement) | whole stage after pose |",
+        "| --- | ---: | ---: |",
+        f"| worst case over inputs | {worst.total.describe()} | {stage_worst.describe()} |",
+        f"| mean over the {len(feats)} recorded frames (min-max) | {mean:.1f} ({lo}-{hi}) "
+        f"| {stage_mean:.1f} |",
+    ]
+    table = "\n".join(lines)
+    print(table)
+    if not args.no_append:
+        argv = " ".join(shlex.quote(a) for a in sys.argv[1:])
+        append_section(
+            "Stage after pose: time and operation count",
+            f".venv/bin/python bench/post_pose.py {argv}".rstrip(),
+            table,
+        )
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,223 @@
+"""The simulator's own speed: render time, a whole scenario run on one core, sweep throughput.
+
+Each measurement runs in a fresh child process with the sweep workers' environment
+(sim.executors.WORKER_ENV: one Mesa thread, one BLAS thread; onnxruntime gets one thread
+from sim.runner): render time per frame at 768x432 (World.step with and without
+rendering), frames per second of a whole scenario run (sim.runner.run: render +
+pipeline with all five predictors + bookkeeping) pinned to one core with and without
+the ground-truth-crop ablation pipeline, and sweep throughput through sim.executors'
+spawn pool with 1 and 2 workers, with the peak RSS of a worker (ru_maxrss of the
+reaped children).
+
+    .venv/bin/python bench/simulator.py [--frames 60] [--runs 6] [--no-append]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import resource
+import shlex
+import subprocess
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from common import append_section  # noqa: E402
+
+REALTIME_FPS = 15.0
+CASES = (1, 2, 3, 4, 5, 6, 8)  # walking cases; still (9) has no motion to predict
+
+
+def scenario(case: int, frames: int, seed: int = 0) -> Any:
+    """A case at the default 8 m with the robot driving at 2 m/s, `frames` frames at 15 fps."""
+    from monopic.cases import Case
+    from sim.cases import place_case
+
+    return place_case(Case(case), duration=frames / REALTIME_FPS, seed=seed)
+
+
+def child_render(frames: int) -> dict[str, Any]:
+    """World.step with and without rendering, one core; first frame (GL setup) excluded."""
+    import numpy as np
+
+    from sim.world import World
+
+    out: dict[str, Any] = {}
+    for render in (False, True, False, True):  # alternated, the second pair kept
+        sc = scenario(5, frames)
+        with World(sc, render=render) as world:
+            world.reset()
+            ms = []
+            for _ in range(frames - 1):
+                t0 = time.perf_counter()
+                world.step()
+                ms.append((time.perf_counter() - t0) * 1e3)
+        out["render" if render else "no_render"] = ms
+    res = {}
+    for k, v in out.items():
+        a = np.array(v[2:])
+        res[k] = {"p50": float(np.percentile(a, 50)), "p95": float(np.percentile(a, 95))}
+    res["maxrss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return res
+
+
+def child_run(frames: int, ablation: bool) -> dict[str, Any]:
+    """One whole scenario through sim.runner.run, after one warm-up run; frames per second."""
+    from sim.runner import RunSpec, run
+
+    warm = RunSpec(id="warm", scenario=scenario(1, 10), ablation=ablation, stop_at_contact=False)
+    run(warm)
+    results = []
+    for case in (5, 3):
+        spec = RunSpec(
+            id=f"case{case}", scenario=scenario(case, frames), ablation=ablation,
+            stop_at_contact=False,
+        )  # fmt: skip
+        cpu0, t0 = time.process_time(), time.perf_counter()
+        result = run(spec)
+        wall, cpu = time.perf_counter() - t0, time.process_time() - cpu0
+        results.append({"frames": result["frames"], "wall_s": wall, "cpu_s": cpu})
+    return {
+        "runs": results,
+        "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+    }
+
+
+def child_sweep(frames: int, runs: int, workers: int) -> dict[str, Any]:
+    """`runs` scenario runs through sim.executors.local_executor with `workers` processes."""
+    from sim.executors import local_executor
+    from sim.runner import RunSpec
+
+    specs = [
+        RunSpec(
+            id=f"bench/{k:02d}",
+            scenario=scenario(CASES[k % len(CASES)], frames, seed=k),
+            ablation=False,
+            stop_at_contact=False,
+        )
+        for k in range(runs)
+    ]
+    rows: list[dict[str, Any]] = []
+    t0 = time.perf_counter()
+    local_executor(workers)(specs, rows.append)
+    wall = time.perf_counter() - t0
+    errors = [r["error"] for r in rows if "error" in r]
+    if errors:
+        raise RuntimeError(errors[0])
+    return {
+        "wall_s": wall,
+        "runs": len(rows),
+        "frames": sum(r["frames"] for r in rows),
+        "run_wall_s": [r["timing"]["wall_s"] for r in rows],
+        "worker_maxrss_mb": resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024,
+    }
+
+
+def spawn_child(kind: str, pin: bool, **kw: Any) -> dict[str, Any]:
+    from sim.executors import WORKER_ENV
+
+    env = dict(os.environ, **WORKER_ENV)
+    cmd = [sys.executable, str(Path(__file__).resolve()), "--child", kind]
+    for k, v in kw.items():
+        cmd += [f"--{k}", str(v)]
+    if pin:
+        cmd.append("--pin")
+    proc = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False)
+    if proc.returncode != 0:
+        raise RuntimeError(f"{' '.join(cmd)} failed:\n{proc.stderr[-3000:]}")
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--frames", type=int, default=60, help="frames per scenario run (15 fps)")
+    ap.add_argument("--runs", type=int, default=6, help="runs per sweep throughput test")
+    ap.add_argument("--no-append", action="store_true")
+    ap.add_argument("--child", choices=("render", "run", "sweep"), help=argparse.SUPPRESS)
+    ap.add_argument("--pin", action="store_true", help=argparse.SUPPRESS)
+    ap.add_argument("--ablation", type=int, default=0, help=argparse.SUPPRESS)
+    ap.add_argument("--workers", type=int, default=1, help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.child:
+        if args.pin:
+            os.sched_setaffinity(0, sorted(os.sched_getaffinity(0))[:1])
+        if args.child == "render":
+            out = child_render(args.frames)
+        elif args.child == "run":
+            out = child_run(args.frames, bool(args.ablation))
+        else:
+            out = child_sweep(args.frames, args.runs, args.workers)
+        print(json.dumps(out))
+        return
+
+    load0 = os.getloadavg()[0]
+    start = time.perf_counter()
+    render = spawn_child("render", True, frames=args.frames)
+    runs = {ab: spawn_child("run", True, frames=args.frames, ablation=ab) for ab in (0, 1)}
+    sweeps = {
+        w: spawn_child("sweep", False, frames=args.frames, runs=args.runs, workers=w)
+        for w in (1, 2)
+    }
+    load1 = os.getloadavg()[0]
+    r, nr = render["render"], render["no_render"]
+    lines = [
+        f"Scenarios: sim.cases.place_case, 8 m, robot 2 m/s, {args.frames} frames at 15 fps, "
+        f"768x432; child processes with sim.executors.WORKER_ENV; load average "
+        f"{load0:.1f} before, {load1:.1f} after, on {os.cpu_count()} cores; "
+        f"{time.perf_counter() - start:.0f} s in all.",
+        "",
+        "| World.step, one core | p50 | p95 |",
+        "| --- | ---: | ---: |",
+        f"| with rendering (768x432) | {r['p50']:.1f} ms | {r['p95']:.1f} ms |",
+        f"| without rendering (truth only) | {nr['p50']:.1f} ms | {nr['p95']:.1f} ms |",
+        f"| render alone (difference of p50) | {r['p50'] - nr['p50']:.1f} ms | |",
+        "",
+        "| whole scenario run on one core (sim.runner.run) | frames | fps (median of 2 runs) "
+        "| CPU-s per frame | vs real time at 15 fps | peak RSS |",
+        "| --- | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for ab, res in runs.items():
+        fps = sorted(x["frames"] / x["wall_s"] for x in res["runs"])
+        med = (fps[0] + fps[-1]) / 2
+        cpu = sum(x["cpu_s"] for x in res["runs"]) / sum(x["frames"] for x in res["runs"])
+        name = "render + pipeline (5 predictors)" + (" + ground-truth-crop ablation" if ab else "")
+        lines.append(
+            f"| {name} | {res['runs'][0]['frames']} | {med:.1f} ({fps[0]:.1f}-{fps[-1]:.1f}) "
+            f"| {1e3 * cpu:.1f} ms | {med / REALTIME_FPS:.2f}x "
+            f"({'faster' if med >= REALTIME_FPS else 'slower'}) | {res['maxrss_mb']:.0f} MB |"
+        )
+    lines += [
+        "",
+        "| sweep (sim.executors.local_executor, no ablation) | runs | wall | runs per minute "
+        "| frames per second | speed-up | worker peak RSS |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    base = sweeps[1]["frames"] / sweeps[1]["wall_s"]
+    for w, s in sweeps.items():
+        fps = s["frames"] / s["wall_s"]
+        lines.append(
+            f"| {w} worker{'s' if w > 1 else ''} | {s['runs']} | {s['wall_s']:.1f} s "
+            f"| {60 * s['runs'] / s['wall_s']:.1f} | {fps:.1f} | {fps / base:.2f}x "
+            f"| {s['worker_maxrss_mb']:.0f} MB |"
+        )
+    lines.append(
+        "\nSweep wall time includes spawning the workers and loading the models (once per worker)."
+    )
+    table = "\n".join(lines)
+    print(table)
+    if not args.no_append:
+        argv = " ".join(shlex.quote(a) for a in sys.argv[1:])
+        append_section(
+            "Simulator: render time, scenario run on one core, sweep throughput",
+            f".venv/bin/python bench/simulator.py {argv}".rstrip(),
+            table,
+        )
+
+
+if __name__ == "__main__":
+    main()

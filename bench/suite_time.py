@@ -1,0 +1,66 @@
+"""How long the test suite takes: the fast part (-m "not slow") and the whole suite, once each.
+
+Timed once (the issue asks for the suite's own run time, not a distribution); the
+pytest summary line is kept beside the time, since a failing or skipped test changes it.
+
+    .venv/bin/python bench/suite_time.py [--no-append]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shlex
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from common import append_section  # noqa: E402
+
+ROOT = HERE.parent
+SUITES = (
+    ("fast: -m 'not slow'", ["-q", "-m", "not slow"]),
+    ("full", ["-q"]),
+)
+
+
+def run_suite(args: list[str]) -> tuple[float, str, int]:
+    """Wall seconds, pytest's last summary line and its exit code."""
+    cmd = [sys.executable, "-m", "pytest", "-p", "no:cacheprovider", *args]
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True, check=False)
+    wall = time.perf_counter() - t0
+    tail = [ln for ln in proc.stdout.strip().splitlines() if ln.strip()]
+    return wall, (tail[-1].strip("= ") if tail else "(no output)"), proc.returncode
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--no-append", action="store_true")
+    args = ap.parse_args()
+    load0 = os.getloadavg()[0]
+    lines = ["| suite | wall | pytest summary | exit |", "| --- | ---: | --- | ---: |"]
+    for name, pytest_args in SUITES:
+        wall, summary, code = run_suite(pytest_args)
+        lines.append(f"| {name} | {wall:.0f} s | {summary} | {code} |")
+    lines.insert(
+        0,
+        f"`.venv/bin/python -m pytest` as listed, once each; load average {load0:.1f} before, "
+        f"{os.getloadavg()[0]:.1f} after, on {os.cpu_count()} cores.\n",
+    )
+    table = "\n".join(lines)
+    print(table)
+    if not args.no_append:
+        argv = " ".join(shlex.quote(a) for a in sys.argv[1:])
+        append_section(
+            "Test suite run time",
+            f".venv/bin/python bench/suite_time.py {argv}".rstrip(),
+            table,
+        )
+
+
+if __name__ == "__main__":
+    main()
