@@ -1,6 +1,7 @@
 """rerun recordings of a pipeline run: the one logging module of the project.
 
-Entity layout (the simulator adds its ground truth under `truth/` and `world/`):
+Entity layout (sim/recording.py adds the simulator's on the same stream: camera/truth,
+world, topdown, truth, ttc, alarm, robot):
 - camera/image             the frame, JPEG-compressed
 - camera/pose              BlazePose skeleton as keypoints (names, connections)
 - camera/zone              the robot's zone on the image
@@ -10,6 +11,10 @@ Entity layout (the simulator adds its ground truth under `truth/` and `world/`):
 Frames are indexed on the `frame` timeline and on `time` (seconds of the stream).
 The file appears whole or not at all: it is written under a temporary name and renamed
 by `close()`.
+
+Callers that add their own entities (the simulator's sim.recording) log them on the same
+stream, `RunRecording.rec`, after `set_time`, and pass their own blueprint; a frame the
+pipeline did not process can still show its image (`log_image`).
 """
 
 from __future__ import annotations
@@ -49,16 +54,32 @@ def blueprint() -> rrb.Blueprint:
     )
 
 
+def encoded_jpeg(image: np.ndarray, quality: int = JPEG_QUALITY) -> rr.EncodedImage:
+    """An RGB uint8 image as a JPEG rerun image (a tenth of the raw size or less)."""
+    ok, jpeg = cv2.imencode(
+        ".jpg", cv2.cvtColor(image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, quality]
+    )
+    if not ok:
+        raise RuntimeError("JPEG encoding of a frame failed")
+    return rr.EncodedImage(contents=jpeg.tobytes(), media_type="image/jpeg")
+
+
 class RunRecording:
     """Writes one run to a .rrd file."""
 
     def __init__(
-        self, path: Path, application_id: str = "monopic", recording_id: str | None = None
+        self,
+        path: Path,
+        application_id: str = "monopic",
+        recording_id: str | None = None,
+        *,
+        layout: rrb.Blueprint | None = None,
     ):
+        """`layout` replaces the default blueprint (e.g. one with the simulator's views)."""
         self.path = Path(path)
         self.tmp = temporary_sibling(self.path)
         self.rec = rr.RecordingStream(application_id, recording_id=recording_id)
-        self.rec.save(str(self.tmp), default_blueprint=blueprint())
+        self.rec.save(str(self.tmp), default_blueprint=blueprint() if layout is None else layout)
         self.rec.log(
             "camera/pose",
             rr.AnnotationContext(
@@ -76,15 +97,23 @@ class RunRecording:
             self.rec.log(f"features/{name}", rr.SeriesLines(names=name), static=True)
 
     def log_frame(self, image: np.ndarray, result: FrameResult) -> None:
+        """One processed frame: its image and everything the pipeline found."""
+        self.set_time(result.frame_index, result.timestamp)
+        self.log_image(image)
+        self.log_result(result)
+
+    def set_time(self, frame_index: int, timestamp: float) -> None:
+        """Put what is logged next on this frame of both timelines."""
+        self.rec.set_time("frame", sequence=frame_index)
+        self.rec.set_time("time", duration=timestamp)
+
+    def log_image(self, image: np.ndarray, entity: str = "camera/image") -> None:
+        """An RGB image, JPEG-compressed, at the current time."""
+        self.rec.log(entity, encoded_jpeg(image))
+
+    def log_result(self, result: FrameResult) -> None:
+        """The pipeline's outputs for the current frame (pose, zone, prediction, series)."""
         rec = self.rec
-        rec.set_time("frame", sequence=result.frame_index)
-        rec.set_time("time", duration=result.timestamp)
-        ok, jpeg = cv2.imencode(
-            ".jpg", cv2.cvtColor(image, cv2.COLOR_RGB2BGR), [cv2.IMWRITE_JPEG_QUALITY, JPEG_QUALITY]
-        )
-        if not ok:
-            raise RuntimeError("JPEG encoding of a frame failed")
-        rec.log("camera/image", rr.EncodedImage(contents=jpeg.tobytes(), media_type="image/jpeg"))
         pose = result.pose.pose
         if pose is not None:
             rec.log(

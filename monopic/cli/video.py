@@ -15,29 +15,14 @@ from monopic.camera import CameraModel
 from monopic.cli.args import non_negative_float, positive_float, positive_int
 from monopic.errors import UserError
 from monopic.frame import EgoState
+from monopic.framelog import FRAME_COLUMNS, frame_row
 from monopic.output import atomic_path
 from monopic.overlay import draw
-from monopic.pipeline import FrameResult, Pipeline, PipelineConfig, Variant
-from monopic.pose.skeleton import LEFT_SHOULDER, RIGHT_SHOULDER
+from monopic.pipeline import Pipeline, PipelineConfig, Variant
 from monopic.pose.tracker import TrackerConfig
 from monopic.predict.base import Mode
-from monopic.predict.rules import IMAGE_DEAD_ZONE_PX_S
 from monopic.predictors import PREDICTOR_NAMES, make_predictor
 from monopic.video import VideoSource
-
-# The authors' log columns (their README), then ours.
-AUTHORS_COLUMNS = (
-    "frameNumber", "windowSize", "XYError", "timeToFuture", "time", "fps",
-    "currentCenterX", "currentCenterY", "leftShoulderX", "leftShoulderY",
-    "rightShoulderX", "rightShoulderY", "angleOfApproach", "XFrameSpeed", "YFrameSpeed",
-    "occupiedHeights", "predictedX", "predictedY",
-)  # fmt: skip
-OUR_COLUMNS = (
-    "case", "caseName", "phiRaw", "footX", "footY", "predictedFootX", "predictedFootY",
-    "apparentHeight", "poseScore", "collision", "risk", "groundX", "groundY", "groundVx",
-    "groundVy", "predictedGroundX", "predictedGroundY", "detectorRuns", "detectMs",
-    "landmarksMs", "featuresMs", "predictMs", "warningMs", "totalMs",
-)  # fmt: skip
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -96,7 +81,7 @@ def run(args: argparse.Namespace) -> int:
             tmp = stack.enter_context(atomic_path(args.csv))
             handle = stack.enter_context(open(tmp, "w", newline=""))
             csv_writer = csv.writer(handle)
-            csv_writer.writerow(AUTHORS_COLUMNS + OUR_COLUMNS)
+            csv_writer.writerow(FRAME_COLUMNS)
         if args.rrd is not None:
             from monopic.recording import RunRecording
 
@@ -116,7 +101,7 @@ def run(args: argparse.Namespace) -> int:
                     annotated = draw(frame.image, result, variant, fps_now)
                     writer.write(cv2.cvtColor(annotated, cv2.COLOR_RGB2BGR))
                 if csv_writer is not None and result.features is not None:
-                    csv_writer.writerow(_row(result, fps_now, args.horizon))
+                    csv_writer.writerow(frame_row(result, fps_now, args.horizon))
                 if recording is not None:
                     recording.log_frame(frame.image, result)
         except BaseException:
@@ -139,31 +124,3 @@ def _ego(args: argparse.Namespace, width: int, height: int) -> EgoState | None:
         raise UserError("camera geometry needs both --fov and --camera-height")
     camera = CameraModel.from_fov(width, height, args.fov, args.camera_height, args.pitch)
     return EgoState(camera=camera, speed=args.speed)
-
-
-def _row(r: FrameResult, fps: float, horizon: float) -> list:
-    f, p, w = r.features, r.prediction, r.warning
-    pose = r.pose.pose
-    ls, rs = pose.landmarks[LEFT_SHOULDER], pose.landmarks[RIGHT_SHOULDER]
-    g = f.ground
-    pg = p.ground if p is not None else None
-    ms = r.stage_ms
-    nan = float("nan")
-    return [
-        r.frame_index, 4, IMAGE_DEAD_ZONE_PX_S, horizon, f"{r.timestamp:.6f}", f"{fps:.3f}",
-        f"{f.center[0]:.2f}", f"{f.center[1]:.2f}", f"{ls[0]:.2f}", f"{ls[1]:.2f}",
-        f"{rs[0]:.2f}", f"{rs[1]:.2f}", f"{f.phi:.4f}", f"{f.vx:.4f}", f"{f.vy:.4f}",
-        f"{f.apparent_height / r.image_size[1]:.5f}",
-        f"{p.center[0]:.2f}" if p else "", f"{p.center[1]:.2f}" if p else "",
-        int(p.case) if p else "", p.case.label if p else "", f"{f.phi_raw:.4f}",
-        f"{f.foot[0]:.2f}", f"{f.foot[1]:.2f}",
-        f"{p.foot[0]:.2f}" if p else "", f"{p.foot[1]:.2f}" if p else "",
-        f"{f.apparent_height:.2f}", f"{pose.score:.4f}",
-        int(w.collision) if w else "", w.risk.value if w else "",
-        f"{g.position[0]:.3f}" if g else "", f"{g.position[1]:.3f}" if g else "",
-        f"{g.velocity[0]:.3f}" if g else "", f"{g.velocity[1]:.3f}" if g else "",
-        f"{pg[0]:.3f}" if pg else "", f"{pg[1]:.3f}" if pg else "",
-        r.pose.detector_runs, f"{ms.get('detect', nan):.3f}", f"{ms.get('landmarks', nan):.3f}",
-        f"{ms.get('features', nan):.3f}", f"{ms.get('predict', nan):.3f}",
-        f"{ms.get('warning', nan):.3f}", f"{ms.get('total', nan):.3f}",
-    ]  # fmt: skip

@@ -1,0 +1,165 @@
+"""`monopic closed-loop`: brake on the pipeline's warning and count the contacts avoided."""
+
+from __future__ import annotations
+
+import argparse
+import platform
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from tqdm import tqdm
+
+from monopic.cli.args import non_negative_float
+from monopic.errors import UserError
+from monopic.output import write_text_atomically
+
+if TYPE_CHECKING:  # the simulator is imported when the command runs
+    from sim.scenario import Scenario
+
+FAMILY_FOLDER = Path("scenarios/families/small")
+# The Euro NCAP-style collision families at the small robot's scale.
+NCAP_FAMILIES = ("cpna25", "cpna75", "cpfa50", "cpnco50", "cpla25", "cpla50")
+DEFAULT_POLICIES = "none,truth,rules/image,rules/ground"
+MEET_TIME = 3.0  # s: --cases crossings meet the robot then unless it brakes
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "closed-loop",
+        help="brake on the pipeline's warning (with its latency): contacts with and without",
+        description="Run each scenario in the gymnasium environment once per policy: 'none' "
+        "(never brakes), 'truth' (brakes when the ground truth says contact within the "
+        "horizon) and PREDICTOR/MODE (brakes at the robot's maximum deceleration when that "
+        "predictor warns; the command acts after the pipeline's measured latency, at the "
+        "next frame boundary). Prints contact rate, impact speed and minimum footprint gap "
+        "per policy. Default scenarios: the small-robot Euro NCAP-style collision families "
+        f"({', '.join(NCAP_FAMILIES)} in {FAMILY_FOLDER}) at each --speeds.",
+    )
+    p.add_argument("files", nargs="*", type=Path, metavar="SCENARIO.toml")
+    p.add_argument(
+        "--cases",
+        help="instead of files: place_case crossings on a collision course, e.g. 5,6 "
+        f"(they meet the robot's front at {MEET_TIME:g} s unless it brakes)",
+    )
+    p.add_argument("--speeds", default="1,2,3", help="robot speeds, m/s (default 1,2,3)")
+    p.add_argument("--policies", default=DEFAULT_POLICIES, help=f"default {DEFAULT_POLICIES}")
+    p.add_argument(
+        "--latency-ms",
+        type=non_negative_float,
+        help="apply this fixed latency instead of the measured one",
+    )
+    p.add_argument("--seed", type=int, default=0, help="environment seed (gait phase)")
+    p.add_argument("--out", type=Path, help="write the tables (Markdown) here")
+    p.add_argument("--rrd-dir", type=Path, help="record every braking run into this folder")
+    p.set_defaults(func=run)
+
+
+def _numbers(text: str, option: str) -> list[float]:
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise UserError(f"{option}: expected numbers separated by commas, got {text!r}") from None
+    if not values or any(not v >= 0 for v in values):
+        raise UserError(f"{option}: expected numbers >= 0, got {text!r}")
+    return values
+
+
+def case_scenarios(cases: str, speeds: list[float]) -> list[Scenario]:
+    from monopic.cases import Case
+    from sim.cases import place_case
+
+    out = []
+    for text in cases.split(","):
+        try:
+            case = Case(int(text))
+        except ValueError:
+            raise UserError(f"--cases: {text!r} is not a case number 1-9") from None
+        if case.lateral == 0:
+            raise UserError(f"--cases: case {int(case)} ({case.label}) does not cross the path")
+        for v in speeds:
+            if v <= 0:
+                raise UserError("--speeds: a crossing needs a moving robot (> 0 m/s)")
+            out.append(
+                place_case(
+                    case,
+                    distance=v * MEET_TIME,
+                    robot_speed=v,
+                    meet_time=MEET_TIME,
+                    duration=MEET_TIME + 1.0,
+                    name=f"case{int(case)}@{v:g}",
+                )
+            )
+    return out
+
+
+def file_scenarios(files: list[Path], speeds: list[float], seed: int) -> list[Scenario]:
+    from sim.scenario_file import load
+
+    out = []
+    for path in files:
+        sf = load(path)
+        for v in speeds:
+            out.append(sf.scenario({"robot.speed": v}, name=f"{sf.name}@{v:g}", seed=seed))
+    return out
+
+
+def run(args: argparse.Namespace) -> int:
+    from sim.closed_loop import NO_BRAKE, format_runs, format_table, run_closed_loop, summarise
+
+    speeds = _numbers(args.speeds, "--speeds")
+    policies = [p.strip() for p in args.policies.split(",") if p.strip()]
+    for policy in policies:
+        if policy not in ("none", "truth") and policy.count("/") != 1:
+            raise UserError(f"--policies: {policy!r} is not none, truth or PREDICTOR/MODE")
+    if NO_BRAKE not in policies:
+        policies.insert(0, NO_BRAKE)  # the baseline every other policy is judged against
+    for out in (args.out,):
+        if out is not None and not out.parent.is_dir():
+            raise UserError(f"{out}: its folder {out.parent} does not exist")
+    if args.rrd_dir is not None and not args.rrd_dir.is_dir():
+        raise UserError(f"--rrd-dir {args.rrd_dir}: no such folder")
+    if args.cases:
+        if args.files:
+            raise UserError("give scenario files or --cases, not both")
+        scenarios = case_scenarios(args.cases, speeds)
+        source = f"place_case crossings {args.cases} meeting the robot at {MEET_TIME:g} s"
+    else:
+        files = args.files or [FAMILY_FOLDER / f"{name}.toml" for name in NCAP_FAMILIES]
+        scenarios = file_scenarios(files, speeds, args.seed)
+        source = ", ".join(str(f) for f in files)
+    outcomes = []
+    with tqdm(total=len(scenarios) * len(policies), unit="run") as bar:
+        for scenario in scenarios:
+            for policy in policies:
+                bar.set_description(f"{scenario.name} {policy}")
+                rrd = None
+                if args.rrd_dir is not None and policy != NO_BRAKE:
+                    rrd = args.rrd_dir / f"{scenario.name}-{policy.replace('/', '-')}.rrd"
+                try:
+                    outcomes.append(
+                        run_closed_loop(
+                            scenario, policy, seed=args.seed, latency_ms=args.latency_ms, rrd=rrd
+                        )
+                    )
+                except ValueError as err:
+                    raise UserError(f"policy {policy!r}: {err}") from None
+                bar.update(1)
+    cam = scenarios[0].robot.camera
+    latency = "measured per frame" if args.latency_ms is None else f"fixed {args.latency_ms:g} ms"
+    ran_on = (
+        f"{len(scenarios)} scenarios ({source}; robot speeds {args.speeds} m/s), seed "
+        f"{args.seed}, {cam.width}x{cam.height} frames at {1 / scenarios[0].dt:.0f} fps, "
+        f"horizon {scenarios[0].horizon:g} s, latency {latency}; "
+        f"{platform.processor() or platform.machine()}, {platform.node()}"
+    )
+    table = format_table(summarise(outcomes))
+    print(table)
+    print(f"\nRan on: {ran_on}")
+    if args.out is not None:
+        text = (
+            f"# Closed loop: braking on the warning\n\nRan on: {ran_on}\n\n{table}\n\n"
+            f"## Runs\n\n{format_runs(outcomes)}\n"
+        )
+        write_text_atomically(args.out, text)
+        print(f"tables: {args.out}")
+    return 0

@@ -1,0 +1,151 @@
+"""`monopic record SCENARIO`: run one simulated scenario through the pipeline into a .rrd file."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from tqdm import tqdm
+
+from monopic.cases import Case
+from monopic.cli.args import non_negative_float, positive_float
+from monopic.errors import UserError
+
+if TYPE_CHECKING:  # the simulator is imported when a command runs, not when the CLI starts
+    from sim.scenario import Scenario
+
+DEFAULT_FOLDER = Path("recordings")
+SCENARIO_HELP = """\
+SCENARIO is a case number 1-9 or its name (e.g. 5, case5, perpendicular-right), or
+`crossing` (an adult crossing into the robot's path; contact at 2.7 s unless it
+brakes), or a scenario file (scenarios/**/*.toml: its base scenario, without its sweep).
+Cases are placed by sim.cases.place_case; the options below set its parameters.
+"""
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "record",
+        help="record a simulated scenario run (camera, pipeline, truth, world) to .rrd",
+        description="Render a scenario, run every frame through the pipeline (all predictors, "
+        "image and ground mode) and write a rerun recording: the camera with the pose, "
+        "predictions and the ground truth, a 3D world view, highway-env's top-down view, "
+        "time series and warnings. Open it with `monopic view FILE.rrd`.\n\n" + SCENARIO_HELP,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    p.add_argument("scenario", metavar="SCENARIO")
+    p.add_argument("--rrd", type=Path, help="output file (default recordings/<scenario>.rrd)")
+    p.add_argument(
+        "--topdown-every",
+        type=int,
+        default=3,
+        metavar="N",
+        help="log highway-env's top-down view every N frames (0: never; default 3)",
+    )
+    p.add_argument(
+        "--after-contact",
+        action="store_true",
+        help="keep running after the footprints meet (default: stop at contact)",
+    )
+    add_case_options(p)
+    p.set_defaults(func=run)
+
+
+def add_case_options(p: argparse.ArgumentParser) -> None:
+    """place_case's parameters, for scenarios given as a case."""
+    g = p.add_argument_group("case placement (SCENARIO given as a case)")
+    g.add_argument("--distance", type=float, default=8.0, help="m ahead where it crosses (8)")
+    g.add_argument("--lateral-offset", type=float, default=0.0, help="m to the left (0)")
+    g.add_argument("--pedestrian-speed", type=positive_float, default=1.4, help="m/s (1.4)")
+    g.add_argument("--robot-speed", type=non_negative_float, default=2.0, help="m/s (2)")
+    g.add_argument("--duration", type=positive_float, default=4.0, help="s (4)")
+    g.add_argument("--seed", type=int, default=0, help="gait phase seed (0)")
+
+
+def parse_case(text: str) -> Case | None:
+    """A case from '5', 'case5' or 'perpendicular-right'; None if it is none of these."""
+    key = text.strip().lower().replace("_", "-").replace(" ", "-")
+    number = key.removeprefix("case")
+    if number.isdigit():
+        value = int(number)
+        if not 1 <= value <= 9:
+            raise UserError(f"scenario {text!r}: case numbers run from 1 to 9")
+        return Case(value)
+    for case in Case:
+        if key == case.label.replace(" ", "-"):
+            return case
+    return None
+
+
+def scenario_from_file(path: Path) -> Scenario:
+    """The base scenario of a scenario file (sim.scenario_file)."""
+    try:
+        module = importlib.import_module("sim.scenario_file")
+    except ModuleNotFoundError:
+        raise UserError(f"{path}: scenario files are not supported in this checkout") from None
+    if hasattr(module, "load_scenario"):
+        return module.load_scenario(path)
+    return module.load(path).base
+
+
+def resolve_scenario(text: str, args: argparse.Namespace) -> Scenario:
+    """The Scenario named on the command line (see SCENARIO_HELP)."""
+    from sim.cases import default_crossing, place_case
+
+    if text.endswith(".toml") or Path(text).is_file():
+        return scenario_from_file(Path(text))
+    if text.strip().lower() == "crossing":
+        return default_crossing()
+    case = parse_case(text)
+    if case is None:
+        raise UserError(
+            f"scenario {text!r}: not a case number 1-9, a case name (e.g. perpendicular-right), "
+            "'crossing' or an existing .toml file"
+        )
+    try:
+        return place_case(
+            case,
+            distance=args.distance,
+            lateral_offset=args.lateral_offset,
+            pedestrian_speed=args.pedestrian_speed,
+            robot_speed=args.robot_speed,
+            duration=args.duration,
+            seed=args.seed,
+        )
+    except ValueError as err:
+        raise UserError(f"scenario {text!r}: {err}") from None
+
+
+def run(args: argparse.Namespace) -> int:
+    from sim.recording import record_run
+
+    if args.topdown_every < 0:
+        raise UserError(f"--topdown-every: must be >= 0, got {args.topdown_every}")
+    scenario = resolve_scenario(args.scenario, args)
+    path: Path = args.rrd or DEFAULT_FOLDER / f"{scenario.name}.rrd"
+    if args.rrd is None:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    elif not path.parent.is_dir():
+        raise UserError(f"{path}: its folder {path.parent} does not exist")
+    with tqdm(total=scenario.frames, unit="frame", desc=scenario.name) as bar:
+        summary = record_run(
+            scenario,
+            path,
+            topdown_every=args.topdown_every,
+            stop_at_contact=not args.after_contact,
+            on_frame=lambda _: bar.update(1),
+        )
+    contact = (
+        f"contact at {summary.contact_time:.2f} s" if summary.contact_time is not None else "none"
+    )
+    warned = ", ".join(f"{k} {v}" for k, v in summary.warned.items()) or "none"
+    print(
+        f"{summary.frames} frames ({scenario.dt * summary.frames:.1f} s), pose found in "
+        f"{summary.found}; true collision within the horizon in {summary.collision_frames}; "
+        f"contact: {contact}"
+    )
+    print(f"frames with a warning: {warned}")
+    print(f"recording: {path} ({summary.bytes / 1e6:.1f} MB); open it with: monopic view {path}")
+    return 0

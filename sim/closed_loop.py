@@ -1,0 +1,362 @@
+"""The closed loop: the robot brakes when the pipeline warns, late by the pipeline's own latency.
+
+Each run steps the gymnasium environment (sim.env, `monopic/PedestrianCrossing-v0`) one
+frame at a time. A policy turns each frame into a brake decision:
+
+- "none": never brakes (the baseline the contacts are counted against);
+- "truth": brakes when the ground truth says the footprints meet within the horizon (an
+  oracle: what a perfect warning with the same horizon and brake would achieve);
+- "<predictor>/<mode>", e.g. "rules/image" or "rules/ground": brakes on that predictor's
+  collision warning; the pipeline sees only the camera frame, its timestamp and the
+  robot's own state.
+
+Latency: a frame captured at step k whose processing took L seconds (the pipeline's own
+measured `stage_ms["total"]`, or a fixed figure) is known at t_k + L, and its command acts
+from the first frame boundary at or after that, i.e. on the step leaving frame
+k + ceil(L / dt). Commands are latched: once the brake acts the robot brakes at its
+maximum deceleration (RobotSpec.max_deceleration) until it stands, and stays standing
+(an emergency stop, as AEB systems do; a false alarm therefore costs the rest of the run).
+The pipeline processes every frame even when L > dt (a real robot would drop frames).
+
+Per run: contact (footprints meet, sim.ground_truth), the robot's speed at contact
+(impact speed), the smallest gap between the footprints, when the first warning came and
+when the brake acted.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import gymnasium
+import numpy as np
+
+from monopic.pipeline import Pipeline, PipelineConfig
+from monopic.pose.tracker import TrackerConfig
+from monopic.predict.base import Mode
+from monopic.predictors import make_predictor
+from monopic.variants.warning import CollisionWarning
+from sim.env import ENV_ID
+from sim.recording import SimRecording, footprint_gap
+from sim.scenario import Scenario
+from sim.world import World, WorldStep
+
+NO_BRAKE = "none"
+ORACLE = "truth"
+
+
+@dataclass(frozen=True)
+class LoopOutcome:
+    """One closed-loop run."""
+
+    scenario: str
+    policy: str
+    seed: int
+    frames: int
+    contact: bool
+    contact_time: float | None
+    impact_speed: float | None  # robot speed at contact, m/s
+    min_gap: float  # m between the footprints (0: contact)
+    first_warning_time: float | None  # s, capture time of the first warned frame
+    brake_time: float | None  # s, when the brake started to act
+    warned_frames: int
+    start_speed: float
+    final_speed: float
+    latencies_ms: tuple[float, ...] = field(repr=False, default=())
+    delays: tuple[int, ...] = field(repr=False, default=())  # frames, per warned frame
+
+    @property
+    def braked(self) -> bool:
+        return self.brake_time is not None
+
+
+class LatencyBrake:
+    """Warnings in, acceleration commands out, each late by the latency of its frame.
+
+    `observe(k, warned, latency_s)` after processing frame k; `action(k)` is the
+    acceleration for the step leaving frame k. Pure bookkeeping, so it is tested alone.
+    """
+
+    def __init__(self, dt: float, deceleration: float) -> None:
+        if not (dt > 0 and deceleration > 0):
+            raise ValueError(f"dt and deceleration must be positive, got {dt}, {deceleration}")
+        self.dt = dt
+        self.deceleration = deceleration
+        self.brake_from: int | None = None  # first step the brake acts on
+        self.first_warning: int | None = None
+        self.delays: list[int] = []
+
+    def delay_frames(self, latency_s: float) -> int:
+        """Frame boundaries until a command computed in `latency_s` can act."""
+        if not (math.isfinite(latency_s) and latency_s >= 0):
+            raise ValueError(f"latency must be a finite number >= 0 s, got {latency_s}")
+        return max(0, math.ceil(latency_s / self.dt - 1e-9))
+
+    def observe(self, index: int, warned: bool, latency_s: float) -> None:
+        if not warned:
+            return
+        delay = self.delay_frames(latency_s)
+        self.delays.append(delay)
+        if self.first_warning is None:
+            self.first_warning = index
+        acts = index + delay
+        if self.brake_from is None or acts < self.brake_from:
+            self.brake_from = acts
+
+    def braking(self, index: int) -> bool:
+        return self.brake_from is not None and index >= self.brake_from
+
+    def action(self, index: int) -> float:
+        """m/s^2 for the step leaving frame `index`."""
+        return -self.deceleration if self.braking(index) else 0.0
+
+
+def policy_pipeline(scenario: Scenario, policy: str) -> Pipeline:
+    """A pipeline whose primary (only) predictor is the policy's, e.g. 'rules/ground'."""
+    from sim.runner import robot_geometry
+
+    name, _, mode = policy.partition("/")
+    if mode not in {m.value for m in Mode}:
+        raise ValueError(f"policy {policy!r}: expected 'none', 'truth' or PREDICTOR/MODE")
+    config = PipelineConfig(
+        horizon=scenario.horizon,
+        mode=Mode(mode),
+        tracker=TrackerConfig(threads=1),
+        warning=CollisionWarning(robot=robot_geometry(scenario)),
+    )
+    return Pipeline(config, make_predictor(name, Mode(mode)))
+
+
+def run_closed_loop(
+    scenario: Scenario,
+    policy: str,
+    *,
+    seed: int = 0,
+    latency_ms: float | None = None,
+    rrd: Path | None = None,
+    on_frame: Callable[[int], None] | None = None,
+) -> LoopOutcome:
+    """One run of `scenario` under `policy` (see the module docstring).
+
+    `latency_ms` None applies the pipeline's measured latency per frame (the oracle has
+    none); a number applies that fixed latency instead. `rrd` records the run.
+    """
+    fps = round(1.0 / scenario.dt)
+    env = gymnasium.make(
+        ENV_ID,
+        config={"scenario": scenario, "simulation_frequency": fps, "policy_frequency": fps},
+    )
+    try:
+        env.reset(seed=seed)
+        world: World = env.unwrapped.world
+        pipeline = None if policy in (NO_BRAKE, ORACLE) else policy_pipeline(scenario, policy)
+        brake = LatencyBrake(scenario.dt, scenario.robot.max_deceleration)
+        recording = SimRecording(rrd, world) if rrd is not None else None
+        try:
+            outcome = _loop(env, world, scenario, policy, pipeline, brake, latency_ms, recording,
+                            seed, on_frame)  # fmt: skip
+        except BaseException:
+            if recording is not None:
+                recording.abort()
+            raise
+        if recording is not None:
+            recording.close()
+        return outcome
+    finally:
+        env.close()
+
+
+def _loop(
+    env: gymnasium.Env,
+    world: World,
+    scenario: Scenario,
+    policy: str,
+    pipeline: Pipeline | None,
+    brake: LatencyBrake,
+    latency_ms: float | None,
+    recording: SimRecording | None,
+    seed: int,
+    on_frame: Callable[[int], None] | None,
+) -> LoopOutcome:
+    step: WorldStep | None = world.last
+    assert step is not None
+    start_speed = step.truth.robot.speed
+    min_gap = math.inf
+    latencies: list[float] = []
+    warned_frames = 0
+    first_warning_time = brake_time = None
+    contact_time = impact_speed = None
+    k = 0
+    while True:
+        truth = step.truth
+        min_gap = min(min_gap, footprint_gap(truth, scenario.pedestrian.footprint))
+        result = None
+        if truth.contact:
+            contact_time, impact_speed = truth.time, truth.robot.speed
+        if pipeline is not None:
+            assert step.frame is not None
+            result = pipeline.process(step.frame)
+            warned = bool(result.warning is not None and result.warning.collision)
+            measured = result.stage_ms["total"]
+            latencies.append(measured)
+            latency = (measured if latency_ms is None else latency_ms) / 1e3
+        elif policy == ORACLE:
+            warned = truth.collision
+            latency = 0.0 if latency_ms is None else latency_ms / 1e3
+        else:
+            warned, latency = False, 0.0
+        warned_frames += int(warned)
+        if warned and first_warning_time is None:
+            first_warning_time = truth.time
+        brake.observe(k, warned, latency)
+        action = brake.action(k)
+        if recording is not None:
+            recording.log_step(step, result)
+            recording.log_series("brake/command", action)
+            if action and brake_time is None:
+                recording.log_event(
+                    f"BRAKE at {-action:g} m/s^2 from this frame ({policy})", "WARN"
+                )
+        if action and brake_time is None:
+            brake_time = truth.time
+        if on_frame is not None:
+            on_frame(k)
+        if truth.contact:
+            break
+        _, _, terminated, truncated, _ = env.step(np.array([action], dtype=np.float32))
+        k += 1
+        step = world.last
+        assert step is not None
+        if step.truth.contact:
+            continue  # the top of the loop records the contact and stops
+        if terminated or truncated:  # the pedestrian is behind the robot, or time is up
+            min_gap = min(min_gap, footprint_gap(step.truth, scenario.pedestrian.footprint))
+            break
+    last = step.truth
+    return LoopOutcome(
+        scenario=scenario.name,
+        policy=policy,
+        seed=seed,
+        frames=k + 1,
+        contact=contact_time is not None,
+        contact_time=contact_time,
+        impact_speed=impact_speed,
+        min_gap=min_gap,
+        first_warning_time=first_warning_time,
+        brake_time=brake_time,
+        warned_frames=warned_frames,
+        start_speed=start_speed,
+        final_speed=last.robot.speed,
+        latencies_ms=tuple(latencies),
+        delays=tuple(brake.delays),
+    )
+
+
+# -- the comparison table ---------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class PolicyRow:
+    """One policy over the same scenarios."""
+
+    policy: str
+    runs: int
+    contacts: int
+    avoided: int | None  # baseline contacts this policy avoided (None for the baseline)
+    baseline_contacts: int
+    impact_mean: float | None
+    impact_max: float | None
+    gap_mean: float
+    gap_min: float
+    braked: int
+    needless_stops: int | None  # braked in runs the baseline finished without contact
+    latency_ms_median: float | None
+    delay_frames_median: float | None
+
+
+def summarise(outcomes: Sequence[LoopOutcome]) -> list[PolicyRow]:
+    """Per policy, over the scenarios every policy ran (baseline first)."""
+    by_policy: dict[str, dict[tuple[str, int], LoopOutcome]] = {}
+    for o in outcomes:
+        by_policy.setdefault(o.policy, {})[(o.scenario, o.seed)] = o
+    baseline = by_policy.get(NO_BRAKE, {})
+    rows = []
+    order = sorted(by_policy, key=lambda p: (p != NO_BRAKE, p != ORACLE, p))
+    for policy in order:
+        runs = by_policy[policy]
+        hit = [o for o in runs.values() if o.contact]
+        speeds = [o.impact_speed for o in hit if o.impact_speed is not None]
+        gaps = [o.min_gap for o in runs.values()]
+        base_hits = {key for key, o in baseline.items() if o.contact and key in runs}
+        avoided = needless = None
+        if policy != NO_BRAKE and baseline:
+            avoided = sum(1 for key in base_hits if not runs[key].contact)
+            clear = [key for key, o in baseline.items() if not o.contact and key in runs]
+            needless = sum(runs[key].braked for key in clear)
+        lat = [v for o in runs.values() for v in o.latencies_ms]
+        delays = [d for o in runs.values() for d in o.delays]
+        rows.append(
+            PolicyRow(
+                policy=policy,
+                runs=len(runs),
+                contacts=len(hit),
+                avoided=avoided,
+                baseline_contacts=len(base_hits),
+                impact_mean=float(np.mean(speeds)) if speeds else None,
+                impact_max=float(np.max(speeds)) if speeds else None,
+                gap_mean=float(np.mean(gaps)),
+                gap_min=float(np.min(gaps)),
+                braked=sum(o.braked for o in runs.values()),
+                needless_stops=needless,
+                latency_ms_median=float(np.median(lat)) if lat else None,
+                delay_frames_median=float(np.median(delays)) if delays else None,
+            )
+        )
+    return rows
+
+
+def _f(x: float | None, fmt: str = ".2f") -> str:
+    return "-" if x is None else format(x, fmt)
+
+
+def format_table(rows: Sequence[PolicyRow]) -> str:
+    """Markdown table of the comparison."""
+    head = (
+        "| policy | runs | contacts | contact rate | baseline contacts avoided | "
+        "impact speed mean / max (m/s) | min gap mean / min (m) | braked | "
+        "braked without need | latency median (ms) | brake delay median (frames) |"
+    )
+    lines = [head, "|" + " --- |" * 11]
+    for r in rows:
+        avoided = (
+            "-"
+            if r.avoided is None
+            else f"{r.avoided}/{r.baseline_contacts}"
+            + (f" ({100 * r.avoided / r.baseline_contacts:.0f} %)" if r.baseline_contacts else "")
+        )
+        lines.append(
+            f"| {r.policy} | {r.runs} | {r.contacts} | {100 * r.contacts / max(r.runs, 1):.0f} % "
+            f"| {avoided} | {_f(r.impact_mean)} / {_f(r.impact_max)} "
+            f"| {_f(r.gap_mean)} / {_f(r.gap_min)} | {r.braked} "
+            f"| {'-' if r.needless_stops is None else r.needless_stops} "
+            f"| {_f(r.latency_ms_median, '.1f')} | {_f(r.delay_frames_median, '.0f')} |"
+        )
+    return "\n".join(lines)
+
+
+def format_runs(outcomes: Sequence[LoopOutcome]) -> str:
+    """Markdown table, one line per run."""
+    lines = [
+        "| scenario | policy | contact | impact speed (m/s) | min gap (m) | first warning (s) "
+        "| brake acts (s) | final speed (m/s) |",
+        "|" + " --- |" * 8,
+    ]
+    for o in outcomes:
+        lines.append(
+            f"| {o.scenario} | {o.policy} | {'yes' if o.contact else 'no'} "
+            f"| {_f(o.impact_speed)} | {o.min_gap:.2f} | {_f(o.first_warning_time)} "
+            f"| {_f(o.brake_time)} | {o.final_speed:.2f} |"
+        )
+    return "\n".join(lines)

@@ -1,0 +1,778 @@
+"""Synthetic datasets: scenario runs rendered into images, COCO keypoints, masks and truth rows.
+
+A dataset spec (scenarios/datasets/*.toml, see scenarios/datasets/README.md) lists grids
+of sim.cases.place_case parameters; every combination is one run of the simulated world,
+every frame of a run one image. For each run the folder gets:
+
+- images/<run>/<frame>.jpg: the robot camera's frame (JPEG, quality 90);
+- masks/<run>/<frame>.png: the pedestrian's pixels from MuJoCo's segmentation rendering
+  (0/255; occluders hide it as in the image);
+- truth/<run>.jsonl: one line per frame, GroundTruth.to_dict() plus the case label and
+  the image and mask file names;
+- features/<run>.csv: the pipeline's own per-frame output in the authors' log columns
+  (monopic.framelog.AUTHORS_COLUMNS, then ours), the rows `monopic video --csv` writes
+  whose authors' columns are all finite (not a track's first frame, which has no
+  velocity yet), so `monopic tree train` and `monopic replay` read them as they read the
+  authors' logs (the pipeline sees only the frames; their reader takes occupiedHeights
+  as a fraction of a 432 px frame, so use 432 px high frames for training);
+- runs/<run>.json: written last, the mark of a finished run (resuming skips it).
+
+Merged over the finished runs after every invocation: annotations/blazepose33.json and
+annotations/coco17.json (COCO keypoints: one 'person' per image where any of it is
+visible, box from the mask, visibility 0 outside the image, 1 hidden behind another
+object, 2 in view; RLE masks), frames.csv (one row per image), runs.csv and README.md
+(the card: what, how, counts, licence).
+
+Deterministic for a spec: the run seeds (the gait phase) derive from the spec's seed and
+the run's index, the renderer and the pose models are deterministic on one machine; only
+the measured-time columns of the features (…Ms) differ between invocations.
+"""
+
+from __future__ import annotations
+
+import csv
+import hashlib
+import io
+import itertools
+import json
+import math
+import platform
+import shutil
+import tomllib
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import cv2
+import numpy as np
+
+from monopic.cases import GROUND_DEAD_ZONE_MPS, Case
+from monopic.errors import UserError
+from monopic.framelog import AUTHORS_COLUMNS, frame_row
+from monopic.framelog import FRAME_COLUMNS as FEATURE_COLUMNS
+from monopic.output import atomic_path, write_text_atomically
+from monopic.pipeline import Pipeline, PipelineConfig
+from monopic.pose.tracker import TrackerConfig
+from monopic.predict.base import Mode
+from monopic.predict.rules import RulePredictor
+from monopic.variants.warning import CollisionWarning
+from sim.cases import OBLIQUE_RANGE_DEG, place_case
+from sim.coco import SKELETONS, category, encode_mask, mask_box, select_keypoints
+from sim.ground_truth import GroundTruth
+from sim.scenario import CameraSpec, RobotSpec, Scenario
+from sim.world import World
+
+FORMAT_VERSION = 1
+JPEG_QUALITY = 90
+# Bytes per frame before any run is measured: JPEG at quality 90 of these renders is about
+# 0.16 byte per pixel; mask, truth line, features row and annotations add a few kB.
+EST_JPEG_BYTES_PER_PIXEL = 0.17
+EST_OTHER_BYTES = 6000
+DEFAULT_LICENCE = "CC-BY-4.0"
+CAMERA_KEYS = ("width", "height", "vertical_fov_deg", "mount_height", "pitch_deg")
+
+
+class SpecError(UserError):
+    """One bad value in a dataset spec: file, field, value and why."""
+
+    def __init__(self, file: Path, field: str, value: object, reason: str) -> None:
+        self.file, self.field, self.value, self.reason = file, field, value, reason
+        super().__init__(f"{file}: {field} = {value!r}: {reason}")
+
+
+@dataclass(frozen=True)
+class Grid:
+    """place_case parameters; the dataset is every combination."""
+
+    cases: tuple[int, ...]
+    distances: tuple[float, ...]
+    lateral_offsets: tuple[float, ...] = (0.0,)
+    pedestrian_speeds: tuple[float, ...] = (1.4,)
+    robot_speeds: tuple[float, ...] = (0.0,)
+    angles: tuple[float, ...] = (45.0,)
+    repeats: int = 1
+
+
+@dataclass(frozen=True)
+class DatasetSpec:
+    path: Path
+    name: str
+    description: str
+    seed: int
+    licence: str
+    duration: float
+    fps: float
+    horizon: float
+    camera: CameraSpec
+    grid: Grid
+    text: str = field(repr=False)  # the file as written, kept in the dataset
+
+    @property
+    def digest(self) -> str:
+        return hashlib.sha256(self.text.encode()).hexdigest()[:16]
+
+
+# -- the spec file -------------------------------------------------------------------
+
+
+class _Table:
+    """Typed, strict reads from one TOML table; leftovers are unknown keys."""
+
+    def __init__(self, path: Path, prefix: str, data: dict[str, Any]) -> None:
+        self.path, self.prefix, self.data = path, prefix, dict(data)
+
+    def name(self, key: str) -> str:
+        return f"{self.prefix}{key}"
+
+    def error(self, key: str, value: object, reason: str) -> SpecError:
+        return SpecError(self.path, self.name(key), value, reason)
+
+    def text(self, key: str, default: str | None = None) -> str:
+        value = self.data.pop(key, default)
+        if value is None:
+            raise SpecError(self.path, self.name(key), None, "is required")
+        if not isinstance(value, str):
+            raise self.error(key, value, "must be a string")
+        return value
+
+    def number(
+        self, key: str, default: float, low: float | None = None, high: float | None = None
+    ) -> float:
+        value = self.data.pop(key, default)
+        return self._check_number(key, value, low, high)
+
+    def _check_number(
+        self, key: str, value: object, low: float | None, high: float | None
+    ) -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.error(key, value, "must be a number")
+        v = float(value)
+        if not math.isfinite(v):
+            raise self.error(key, value, "must be finite")
+        if low is not None and v < low:
+            raise self.error(key, value, f"must be >= {low:g}")
+        if high is not None and v > high:
+            raise self.error(key, value, f"must be <= {high:g}")
+        return v
+
+    def integer(self, key: str, default: int, low: int, high: int) -> int:
+        value = self.data.pop(key, default)
+        if isinstance(value, bool) or not isinstance(value, int):
+            raise self.error(key, value, "must be an integer")
+        if not low <= value <= high:
+            raise self.error(key, value, f"must be between {low} and {high}")
+        return value
+
+    def numbers(
+        self, key: str, default: tuple[float, ...] | None, low: float, high: float
+    ) -> tuple[float, ...]:
+        value = self.data.pop(key, default)
+        if value is None:
+            raise SpecError(self.path, self.name(key), None, "is required (a list of numbers)")
+        if not isinstance(value, list | tuple) or not value:
+            raise self.error(key, value, "must be a non-empty list of numbers")
+        out = tuple(self._check_number(key, v, low, high) for v in value)
+        if len(set(out)) != len(out):
+            raise self.error(key, value, "lists a value twice")
+        return out
+
+    def table(self, key: str) -> _Table:
+        value = self.data.pop(key, {})
+        if not isinstance(value, dict):
+            raise self.error(key, value, "must be a table")
+        return _Table(self.path, f"{self.name(key)}.", value)
+
+    def done(self) -> None:
+        for key, value in self.data.items():
+            raise self.error(key, value, "unknown key (see scenarios/datasets/README.md)")
+
+
+def load_spec(path: Path) -> DatasetSpec:
+    """Read and validate a dataset spec; every mistake is a SpecError naming the field."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except FileNotFoundError:
+        raise UserError(f"{path}: no such dataset spec") from None
+    except (OSError, UnicodeDecodeError) as err:
+        raise UserError(f"{path}: cannot read: {err}") from None
+    try:
+        data = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as err:
+        raise UserError(f"{path}: not valid TOML: {err}") from None
+    top = _Table(path, "", data)
+    name = top.text("name")
+    if not name or any(c.isspace() or c in "/\\" for c in name):
+        raise top.error("name", name, "must be a non-empty name without spaces or slashes")
+    description = top.text("description", "")
+    licence = top.text("licence", DEFAULT_LICENCE)
+    seed = top.integer("seed", 0, 0, 2**31 - 1)
+    duration = top.number("duration", 3.0, 0.2, 60.0)
+    fps = top.number("fps", 15.0, 1.0, 60.0)
+    horizon = top.number("horizon", 1.0, 0.1, 10.0)
+    cam_t = top.table("camera")
+    base = CameraSpec()
+    camera = CameraSpec(
+        width=cam_t.integer("width", base.width, 64, 4096),
+        height=cam_t.integer("height", base.height, 64, 4096),
+        vertical_fov_deg=cam_t.number("vertical_fov_deg", base.vertical_fov_deg, 10.0, 150.0),
+        mount_height=cam_t.number("mount_height", base.mount_height, 0.1, 5.0),
+        pitch_deg=cam_t.number("pitch_deg", base.pitch_deg, -45.0, 45.0),
+    )
+    cam_t.done()
+    g = top.table("grid")
+    cases = g.numbers("cases", None, 1, 9)
+    if any(c != int(c) for c in cases):
+        raise g.error("cases", list(cases), "case numbers are integers 1-9")
+    angles = g.numbers("angles", (45.0,), *OBLIQUE_RANGE_DEG)
+    lo, hi = OBLIQUE_RANGE_DEG
+    for a in angles:
+        if not lo < a < hi:
+            raise g.error(
+                "angles", a, f"an oblique angle must lie strictly between {lo:.1f} and {hi:.1f}"
+            )
+    grid = Grid(
+        cases=tuple(int(c) for c in cases),
+        distances=g.numbers("distances", None, -50.0, 50.0),
+        lateral_offsets=g.numbers("lateral_offsets", (0.0,), -20.0, 20.0),
+        pedestrian_speeds=g.numbers("pedestrian_speeds", (1.4,), GROUND_DEAD_ZONE_MPS, 8.0),
+        robot_speeds=g.numbers("robot_speeds", (0.0,), 0.0, 20.0),
+        angles=angles,
+        repeats=g.integer("repeats", 1, 1, 1000),
+    )
+    g.done()
+    top.done()
+    return DatasetSpec(path, name, description, seed, licence, duration, fps, horizon, camera,
+                       grid, text)  # fmt: skip
+
+
+# -- runs --------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class DatasetRun:
+    """One run of the dataset: its id, the parameters it varies and its scenario."""
+
+    index: int
+    id: str
+    params: dict[str, Any]
+    scenario: Scenario
+
+
+def run_seed(spec_seed: int, index: int) -> int:
+    """The world seed of run `index`: independent streams per run, same for the same spec."""
+    return int(np.random.SeedSequence([spec_seed, index]).generate_state(1)[0] >> 1)
+
+
+def expand(spec: DatasetSpec) -> list[DatasetRun]:
+    """Every combination of the grid, in a fixed order (the run ids follow it).
+
+    Axes a case ignores collapse: standing still has no walking speed or angle, only the
+    oblique cases use the angle.
+    """
+    g = spec.grid
+    combos: list[dict[str, Any]] = []
+    seen = set()
+    for case_n, dist, lat, pspeed, rspeed, angle in itertools.product(
+        g.cases, g.distances, g.lateral_offsets, g.pedestrian_speeds, g.robot_speeds, g.angles
+    ):
+        case = Case(case_n)
+        if case is Case.STILL:
+            pspeed = 0.0
+        if case.lateral == 0 or case.depth == 0:
+            angle = None
+        key = (case_n, dist, lat, pspeed, rspeed, angle)
+        if key in seen:
+            continue
+        seen.add(key)
+        for rep in range(g.repeats):
+            combos.append(
+                {
+                    "case": case_n,
+                    "distance": dist,
+                    "lateral_offset": lat,
+                    "pedestrian_speed": pspeed,
+                    "robot_speed": rspeed,
+                    "angle_deg": angle,
+                    "repeat": rep,
+                }
+            )
+    runs = []
+    robot = replace(RobotSpec(), camera=spec.camera)
+    for index, params in enumerate(combos):
+        run_id = f"r{index:04d}"
+        seed = run_seed(spec.seed, index)
+        try:
+            scenario = place_case(
+                Case(params["case"]),
+                distance=params["distance"],
+                lateral_offset=params["lateral_offset"],
+                pedestrian_speed=params["pedestrian_speed"] or 1.4,
+                robot_speed=params["robot_speed"],
+                angle_deg=params["angle_deg"] or 45.0,
+                duration=spec.duration,
+                dt=1.0 / spec.fps,
+                horizon=spec.horizon,
+                robot=robot,
+                seed=seed,
+                name=f"{spec.name}-{run_id}",
+            )
+        except ValueError as err:
+            raise SpecError(spec.path, "grid", params, str(err)) from None
+        runs.append(DatasetRun(index, run_id, {**params, "seed": seed}, scenario))
+    return runs
+
+
+# -- rendering one run -------------------------------------------------------------------
+
+
+def dataset_pipeline(scenario: Scenario) -> Pipeline:
+    """The paper's image-mode pipeline (rule cascade) whose features the CSV holds."""
+    from sim.runner import robot_geometry
+
+    config = PipelineConfig(
+        horizon=scenario.horizon,
+        mode=Mode.IMAGE,
+        tracker=TrackerConfig(threads=1),
+        warning=CollisionWarning(robot=robot_geometry(scenario)),
+    )
+    return Pipeline(config, RulePredictor(mode=Mode.IMAGE))
+
+
+def keypoints33(truth: GroundTruth, width: int, height: int) -> list[float]:
+    """Flat COCO [x, y, v] * 33: v 0 outside the image (x = y = 0), 1 occluded, 2 in view."""
+    out: list[float] = []
+    for (u, v), hidden in zip(truth.landmarks_px, truth.landmarks_occluded, strict=True):
+        if not (math.isfinite(u) and math.isfinite(v) and 0 <= u < width and 0 <= v < height):
+            out += [0, 0, 0]
+        else:
+            out += [round(float(u), 2), round(float(v), 2), 1 if hidden else 2]
+    return out
+
+
+def _truth_line(run: DatasetRun, frame: int, image: str, mask: str, truth: GroundTruth) -> str:
+    row = {"run": run.id, "frame": frame, "image": image, "mask": mask}
+    row.update(truth.to_dict())
+    row["case_name"] = truth.case.label
+    return json.dumps(row, separators=(",", ":"), default=_plain)
+
+
+def _plain(value: object) -> object:
+    """numpy scalars as Python ones (GroundTruth.to_dict leaves e.g. a numpy bool)."""
+    if isinstance(value, np.generic):
+        return value.item()
+    raise TypeError(f"{type(value).__name__} is not JSON serialisable")
+
+
+def render_run(
+    run: DatasetRun, out: Path, on_frame: Callable[[int], None] | None = None
+) -> dict[str, Any]:
+    """Render one run into `out`; returns (and writes last) its runs/<id>.json record."""
+    scenario = run.scenario
+    cam = scenario.robot.camera
+    for sub in ("images", "masks"):
+        shutil.rmtree(out / sub / run.id, ignore_errors=True)  # a partial earlier attempt
+        (out / sub / run.id).mkdir(parents=True)
+    pipeline = dataset_pipeline(scenario)
+    images, annotations = [], []
+    truth_lines, feature_rows = [], []
+    contact_time = None
+    found = 0
+    with World(scenario, render=True) as world:
+        step = world.reset()
+        for k in range(scenario.frames):
+            if k > 0:
+                step = world.step()
+            assert step.frame is not None
+            truth = step.truth
+            image_name = f"images/{run.id}/{k:04d}.jpg"
+            mask_name = f"masks/{run.id}/{k:04d}.png"
+            bgr = cv2.cvtColor(step.frame.image, cv2.COLOR_RGB2BGR)
+            if not cv2.imwrite(
+                str(out / image_name), bgr, [cv2.IMWRITE_JPEG_QUALITY, JPEG_QUALITY]
+            ):
+                raise OSError(f"cannot write {out / image_name}")
+            mask = world.pedestrian_mask()
+            cv2.imwrite(str(out / mask_name), mask.astype(np.uint8) * 255)
+            result = pipeline.process(step.frame)
+            found += int(result.pose.found)
+            if result.features is not None:
+                row = frame_row(result, 1.0 / scenario.dt, scenario.horizon)
+                if _authors_finite(row):
+                    feature_rows.append(row)
+            image_id = (run.index + 1) * 10000 + k
+            images.append(
+                {
+                    "id": image_id,
+                    "file_name": image_name,
+                    "width": cam.width,
+                    "height": cam.height,
+                    "run": run.id,
+                    "frame": k,
+                    "time": round(step.time, 6),
+                    "mask_file": mask_name,
+                }
+            )
+            area = int(mask.sum())
+            if area > 0:
+                kp = keypoints33(truth, cam.width, cam.height)
+                u0, v0, u1, v1 = truth.box
+                annotations.append(
+                    {
+                        "id": image_id,
+                        "image_id": image_id,
+                        "category_id": 1,
+                        "iscrowd": 0,
+                        "area": area,
+                        "bbox": mask_box(mask),
+                        "amodal_bbox": _clipped_box(u0, v0, u1, v1, cam.width, cam.height),
+                        "segmentation": encode_mask(mask),
+                        "keypoints33": kp,
+                        "case": int(truth.case),
+                        "occluded": bool(truth.occluded),
+                    }
+                )
+            truth_lines.append(_truth_line(run, k, image_name, mask_name, truth))
+            if on_frame is not None:
+                on_frame(k)
+            if truth.contact:
+                contact_time = truth.time
+                break
+    with atomic_path(out / "truth" / f"{run.id}.jsonl") as tmp:
+        tmp.write_text("\n".join(truth_lines) + "\n", encoding="utf-8")
+    buf = io.StringIO()
+    writer = csv.writer(buf, lineterminator="\n")
+    writer.writerow(FEATURE_COLUMNS)
+    writer.writerows(feature_rows)
+    write_text_atomically(out / "features" / f"{run.id}.csv", buf.getvalue())
+    frames = len(images)
+    record = {
+        "format": FORMAT_VERSION,
+        "id": run.id,
+        "index": run.index,
+        "scenario": scenario.name,
+        "params": run.params,
+        "frames": frames,
+        "pose_found": found,
+        "feature_rows": len(feature_rows),
+        "contact_time": contact_time,
+        "images": images,
+        "annotations": annotations,
+    }
+    record["bytes"] = _run_bytes(out, run.id)
+    write_text_atomically(out / "runs" / f"{run.id}.json", json.dumps(record, default=_plain))
+    return record
+
+
+def _authors_finite(row: list[Any]) -> bool:
+    """Whether the authors' columns are all finite numbers, as their log reader demands.
+
+    Not so on a track's first frame (no velocity yet), which the features file leaves out.
+    """
+    try:
+        return all(math.isfinite(float(v)) for v in row[: len(AUTHORS_COLUMNS)])
+    except ValueError:
+        return False
+
+
+def _clipped_box(u0: float, v0: float, u1: float, v1: float, w: int, h: int) -> list[float] | None:
+    if not all(math.isfinite(v) for v in (u0, v0, u1, v1)):
+        return None
+    x0, y0 = min(max(u0, 0.0), w), min(max(v0, 0.0), h)
+    x1, y1 = min(max(u1, 0.0), w), min(max(v1, 0.0), h)
+    return [round(x0, 2), round(y0, 2), round(x1 - x0, 2), round(y1 - y0, 2)]
+
+
+def _run_bytes(out: Path, run_id: str) -> int:
+    total = 0
+    for sub in ("images", "masks"):
+        total += sum(p.stat().st_size for p in (out / sub / run_id).iterdir())
+    for name in (f"truth/{run_id}.jsonl", f"features/{run_id}.csv"):
+        total += (out / name).stat().st_size
+    return total
+
+
+# -- the whole dataset ---------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class SizeEstimate:
+    runs: int
+    frames: int  # upper bound: runs stop at contact
+    bytes_per_frame: float
+    measured: bool
+
+    @property
+    def total_bytes(self) -> float:
+        return self.frames * self.bytes_per_frame
+
+    def text(self) -> str:
+        how = "measured on finished runs" if self.measured else "estimated"
+        return (
+            f"{self.runs} runs x up to {self.frames // max(self.runs, 1)} frames = up to "
+            f"{self.frames} images, ~{self.bytes_per_frame / 1e3:.0f} kB per frame ({how}) "
+            f"-> ~{self.total_bytes / 1e6:.0f} MB"
+        )
+
+
+def estimate(runs: list[DatasetRun], finished: list[dict[str, Any]]) -> SizeEstimate:
+    frames = sum(r.scenario.frames for r in runs)
+    measured = [r for r in finished if r["frames"] > 0]
+    if measured:
+        per = sum(r["bytes"] for r in measured) / sum(r["frames"] for r in measured)
+        return SizeEstimate(len(runs), frames, per, True)
+    cam = runs[0].scenario.robot.camera if runs else CameraSpec()
+    per = cam.width * cam.height * EST_JPEG_BYTES_PER_PIXEL + EST_OTHER_BYTES
+    return SizeEstimate(len(runs), frames, per, False)
+
+
+def finished_runs(out: Path, runs: list[DatasetRun]) -> dict[str, dict[str, Any]]:
+    """Records of the runs already done (their runs/<id>.json exists and matches)."""
+    done = {}
+    for run in runs:
+        path = out / "runs" / f"{run.id}.json"
+        if not path.exists():
+            continue
+        try:
+            record = json.loads(path.read_text(encoding="utf-8"))
+        except json.JSONDecodeError:
+            continue  # written atomically, so only a foreign file gets here: redo the run
+        if record.get("format") == FORMAT_VERSION and record.get("params") == run.params:
+            done[run.id] = record
+    return done
+
+
+def prepare_folder(spec: DatasetSpec, out: Path) -> None:
+    """Create the folder, or check that it holds the same spec's dataset (resume)."""
+    marker = out / "dataset.json"
+    if marker.exists():
+        try:
+            made = json.loads(marker.read_text(encoding="utf-8"))
+        except json.JSONDecodeError:
+            raise UserError(f"{marker}: not a dataset marker (invalid JSON)") from None
+        if made.get("spec_digest") != spec.digest:
+            raise UserError(
+                f"{out}: holds dataset {made.get('name')!r} made from another spec "
+                f"(digest {made.get('spec_digest')} vs {spec.digest}); choose another --out"
+            )
+        return
+    if out.exists() and any(out.iterdir()):
+        raise UserError(f"{out}: exists and is not empty (and is not a dataset of this spec)")
+    for sub in ("images", "masks", "truth", "features", "runs", "annotations"):
+        (out / sub).mkdir(parents=True, exist_ok=True)
+    write_text_atomically(out / "spec.toml", spec.text)
+    write_text_atomically(
+        out / "dataset.json",
+        json.dumps(
+            {"name": spec.name, "spec_digest": spec.digest, "format": FORMAT_VERSION}, indent=1
+        ),
+    )
+
+
+def build(
+    spec: DatasetSpec,
+    out: Path,
+    report: Callable[[str], None] = print,
+    progress: Callable[[int], Callable[[int], None]] | None = None,
+) -> dict[str, Any]:
+    """Render every unfinished run of `spec` into `out`, then merge; returns the counts.
+
+    `report` gets one-line messages (the size estimate first); `progress(total_frames)`,
+    if given, returns the callback called after every rendered frame (e.g. a bar's update).
+    """
+    runs = expand(spec)
+    prepare_folder(spec, out)
+    done = finished_runs(out, runs)
+    todo = [r for r in runs if r.id not in done]
+    size = estimate(runs, list(done.values()))
+    report(f"size: {size.text()}")
+    report(f"{len(done)} of {len(runs)} runs already finished, {len(todo)} to render")
+    on_frame = progress(sum(r.scenario.frames for r in todo)) if progress and todo else None
+    for run in todo:
+        done[run.id] = render_run(run, out, on_frame)
+        if not size.measured:
+            size = estimate(runs, list(done.values()))
+            report(f"size, measured on the first run: {size.text()}")
+    return merge(spec, out, [done[r.id] for r in runs])
+
+
+def merge(spec: DatasetSpec, out: Path, records: list[dict[str, Any]]) -> dict[str, Any]:
+    """Write the COCO files, frames.csv, runs.csv and README.md from the run records."""
+    images = [img for r in records for img in r["images"]]
+    anns = [a for r in records for a in r["annotations"]]
+    for skeleton in SKELETONS:
+        coco = {
+            "info": {
+                "description": f"MonoPIC synthetic dataset {spec.name!r} ({skeleton} keypoints)",
+                "version": str(FORMAT_VERSION),
+                "contributor": "MonoPIC test bed (sim.dataset)",
+            },
+            "licenses": [{"id": 1, "name": spec.licence}],
+            "images": images,
+            "annotations": [_coco_annotation(a, skeleton) for a in anns],
+            "categories": [category(skeleton)],
+        }
+        write_text_atomically(out / "annotations" / f"{skeleton}.json", json.dumps(coco))
+    frames_csv, case_counts = _frames_csv(out, records)
+    write_text_atomically(out / "frames.csv", frames_csv)
+    write_text_atomically(out / "runs.csv", _runs_csv(records))
+    visibility = Counter(v for a in anns for v in a["keypoints33"][2::3])
+    counts = {
+        "runs": len(records),
+        "images": len(images),
+        "annotations": len(anns),
+        "feature_rows": sum(r["feature_rows"] for r in records),
+        "pose_found": sum(r["pose_found"] for r in records),
+        "contacts": sum(r["contact_time"] is not None for r in records),
+        "keypoints_visible": visibility.get(2, 0),
+        "keypoints_occluded": visibility.get(1, 0),
+        "keypoints_outside": visibility.get(0, 0),
+        "cases": dict(sorted(case_counts.items())),
+    }
+    counts["bytes"] = sum(r["bytes"] for r in records)
+    write_text_atomically(out / "README.md", readme(spec, counts))
+    counts["bytes"] = _folder_bytes(out)
+    return counts
+
+
+def _coco_annotation(a: dict[str, Any], skeleton: str) -> dict[str, Any]:
+    kp = select_keypoints(a["keypoints33"], skeleton)
+    out = {k: v for k, v in a.items() if k != "keypoints33"}
+    out["keypoints"] = kp
+    out["num_keypoints"] = sum(1 for v in kp[2::3] if v > 0)
+    return out
+
+
+FRAME_COLUMNS = (
+    "run", "frame", "image", "mask", "time", "case", "case_name", "phi", "forward", "lateral",
+    "velocity_forward", "velocity_left", "heading_robot_deg", "speed", "robot_speed",
+    "time_to_collision", "collision", "contact", "in_frame", "occluded", "visible_fraction",
+    "box_u0", "box_v0", "box_u1", "box_v1", "foot_u", "foot_v",
+)  # fmt: skip
+
+
+def _frames_csv(out: Path, records: list[dict[str, Any]]) -> tuple[str, Counter]:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(FRAME_COLUMNS)
+    cases: Counter = Counter()
+    for r in records:
+        for line in (out / "truth" / f"{r['id']}.jsonl").read_text(encoding="utf-8").splitlines():
+            t = json.loads(line)
+            cases[t["case"]] += 1
+            box = t["box"] or [None] * 4
+            foot = t["foot_px"] or [None, None]
+            w.writerow(
+                [
+                    t["run"], t["frame"], t["image"], t["mask"], t["time"], t["case"],
+                    t["case_name"], t["phi"], *t["position_robot"], *t["velocity_robot"],
+                    math.degrees(t["heading_robot"]), t["speed"], t["robot"]["speed"],
+                    t["time_to_collision"], int(t["collision"]), int(t["contact"]),
+                    int(t["in_frame"]), int(t["occluded"]), t["visible_fraction"], *box, *foot,
+                ]
+            )  # fmt: skip
+    return buf.getvalue(), cases
+
+
+def _runs_csv(records: list[dict[str, Any]]) -> str:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    keys = ("case", "distance", "lateral_offset", "pedestrian_speed", "robot_speed", "angle_deg",
+            "repeat", "seed")  # fmt: skip
+    w.writerow(("run", *keys, "frames", "annotated", "pose_found", "contact_time", "bytes"))
+    for r in records:
+        p = r["params"]
+        w.writerow(
+            (r["id"], *(p[k] for k in keys), r["frames"], len(r["annotations"]), r["pose_found"],
+             r["contact_time"], r["bytes"])
+        )  # fmt: skip
+    return buf.getvalue()
+
+
+def _folder_bytes(out: Path) -> int:
+    return sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
+
+
+def readme(spec: DatasetSpec, counts: dict[str, Any]) -> str:
+    """The dataset card."""
+    import mujoco
+
+    g, cam = spec.grid, spec.camera
+    cases = ", ".join(f"{Case(c).label} ({c}): {n}" for c, n in counts["cases"].items())
+    image_format = f"{cam.width}x{cam.height}, {spec.fps:g} fps, JPEG quality {JPEG_QUALITY}"
+    keypoints = " / ".join(
+        str(counts[k]) for k in ("keypoints_visible", "keypoints_occluded", "keypoints_outside")
+    )
+    return f"""# {spec.name}: a synthetic pedestrian dataset from the MonoPIC test bed
+
+{spec.description}
+
+## What
+
+Images from the forward camera of a small robot driving a MuJoCo street while a
+mannequin pedestrian walks one of the paper's nine motion cases, with ground truth
+from the simulator.
+
+| | |
+| --- | --- |
+| runs | {counts["runs"]} |
+| images | {counts["images"]} ({image_format}) |
+| person annotations (any pixel visible) | {counts["annotations"]} |
+| keypoints in view / occluded / outside the image | {keypoints} |
+| frames where the pipeline found the pose | {counts["pose_found"]} |
+| pipeline feature rows | {counts["feature_rows"]} |
+| runs ending in contact (the run stops there) | {counts["contacts"]} |
+| size (images, masks, truth, features) | {counts["bytes"] / 1e6:.1f} MB |
+
+Frames per ground-truth case (the case of the next second of true motion): {cases}.
+
+## How it was made
+
+`monopic dataset {spec.path.name} --out DIR` (the spec is copied to `spec.toml`), with
+monopic's simulator (sim/), MuJoCo {mujoco.__version__} rendering headless (EGL), on
+{platform.machine()} / Python {platform.python_version()}. Each run is one
+`sim.cases.place_case` scenario, for every combination of:
+
+- cases {list(g.cases)};
+- distances {list(g.distances)} m ahead, lateral offsets {list(g.lateral_offsets)} m;
+- walking speeds {list(g.pedestrian_speeds)} m/s, robot speeds {list(g.robot_speeds)} m/s;
+- oblique angles {list(g.angles)} deg; {g.repeats} repeat(s).
+
+{spec.duration:g} s per run (a run stops at contact), horizon {spec.horizon:g} s. Camera:
+{cam.vertical_fov_deg:g} deg vertical field of view, {cam.mount_height:g} m high,
+pitched {cam.pitch_deg:g} deg down. The gait phase of run k comes from seed {spec.seed}
+and k; the pipeline is the paper's image mode (rule cascade) on one onnxruntime thread.
+
+Deterministic: the same spec gives the same images, masks, annotations and truth on the
+same software; the features' measured-time columns (`detectMs` … `totalMs`) differ
+between invocations. Resumable: finished runs (`runs/<run>.json`) are skipped.
+
+## Files
+
+- `images/<run>/<frame>.jpg`, `masks/<run>/<frame>.png` (0 background, 255 pedestrian,
+  from MuJoCo's segmentation rendering; other objects hide it as in the image);
+- `annotations/blazepose33.json`, `annotations/coco17.json`: COCO keypoint files (one
+  category, `person`; `file_name` relative to this folder; `bbox` from the mask;
+  `segmentation` as COCO compressed RLE; keypoints `[x, y, v]` in pixels with v = 0
+  outside the image, 1 hidden by another object (a MuJoCo ray test), 2 in view; the body
+  hiding itself is not marked; `amodal_bbox` is the whole body's box clipped to the
+  image). COCO-17 keypoints are BlazePose's landmarks of the same names. Images where
+  no pixel of the person shows have no annotation;
+- `truth/<run>.jsonl`: per frame, the simulator's ground truth (`sim.ground_truth.
+  GroundTruth.to_dict()`: positions in the world and the robot frame, velocities, case,
+  true phi, time to collision, collision, contact, landmark pixels, occlusion);
+- `frames.csv`: one row per image with the main truth columns;
+- `features/<run>.csv`: the pipeline's own output per frame with a pose, in the MonoPIC
+  authors' log columns then ours (as `monopic video --csv` writes), leaving out rows
+  without a velocity yet (a track's first frame); `monopic tree train` and `monopic
+  replay` read these files (their reader takes `occupiedHeights` as a fraction of a
+  432 px high frame);
+- `runs.csv`: the parameters of every run.
+
+## Licence
+
+{spec.licence}. Everything in the images is generated by the test bed (procedural
+textures, the mannequin, the street); no third-party data is included.
+"""

@@ -1,0 +1,719 @@
+"""Scenario runs in rerun: what monopic's RunRecording logs plus what only the simulator knows.
+
+One module logs the pipeline (monopic/recording.py, RunRecording); this one adds, on
+the same stream, the ground truth and the world around the camera, and lays the views
+out so the story of a run (what the camera saw, what the pipeline made of it, what was
+really going to happen) reads at a glance. Entities added to RunRecording's:
+
+- camera/truth/{foot,centre,box,path}: the true foot point, torso centre and apparent box,
+  and the true foot path over the next horizon seen by the current camera (the frame the
+  ground-mode prediction is drawn in, so the two compare directly);
+- world/...: a 3D view of the ground plane in the world frame of sim.frames (z up):
+  world/road (edges, lanes, zebra crossing, parked cars; static), world/robot (a
+  Transform3D per frame; below it, in the robot frame, the body, the camera frustum,
+  the swept zone and world/robot/prediction/<predictor>: every ground-mode decision's
+  predicted foot point), world/robot_trail, world/pedestrian (the 33 landmarks as a
+  skeleton, the footprint), world/truth/{path,future} (the whole true path; the part
+  within the horizon);
+- topdown/image: highway-env's top-down view (sim.env.TopDownViewer), every few frames;
+- time series: truth/phi next to features/phi; ttc/truth and ttc/<predictor> (ground mode's
+  predicted time to contact); alarm/truth (contact within the horizon) and
+  alarm/<predictor> (its warning), 0/1; robot/speed and truth/gap (footprint distance);
+- events: first frame on a collision course, contact, pose found and lost, each
+  predictor's warning onset, and whatever the caller adds (`log_event`).
+
+`SimRecording` is the per-frame API a runner calls (the sweep can record every run and
+keep only the ones that went wrong: `close()` keeps the file, `abort()` drops it);
+`record_run` runs one scenario through the pipeline and records it.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from types import SimpleNamespace, TracebackType
+
+import numpy as np
+import rerun as rr
+import rerun.blueprint as rrb
+
+from monopic.pipeline import FrameResult, Pipeline
+from monopic.pose.skeleton import CONNECTIONS, LANDMARK_NAMES
+from monopic.predict.base import Mode
+from monopic.recording import RunRecording, encoded_jpeg
+from monopic.variants.zone import RobotGeometry, swept_ground_zone
+from sim.ground_truth import GroundTruth
+from sim.scenario import Scenario
+from sim.world import World, WorldStep
+
+TRUTH_COLOUR = (0, 210, 255)
+ROBOT_COLOUR = (50, 200, 0)
+PEDESTRIAN_COLOUR = (255, 140, 0)
+ROAD_COLOUR = (150, 150, 150)
+PREDICTION_COLOURS = ((255, 80, 200), (255, 200, 40), (120, 120, 255), (255, 90, 60))
+ROBOT_BODY_HEIGHT = 0.4  # m, only for drawing
+PATH_SAMPLES = 11  # points on the true path over the horizon
+DEFAULT_TOPDOWN_EVERY = 3  # frames between top-down images (5 per second at 15 fps)
+
+
+def entity_name(predictor: str) -> str:
+    """A predictor key ("rules/ground") as one entity path part ("rules-ground")."""
+    return predictor.replace("/", "-")
+
+
+# -- footprints ----------------------------------------------------------------------
+
+
+def rectangle(centre: np.ndarray, yaw: float, length: float, width: float) -> np.ndarray:
+    """Corners (4, 2) of a rectangle on the ground, counter-clockwise."""
+    c, s = math.cos(yaw), math.sin(yaw)
+    half = np.array([[1, 1], [-1, 1], [-1, -1], [1, -1]]) * [length / 2, width / 2]
+    return np.asarray(centre, dtype=float)[:2] + half @ np.array([[c, s], [-s, c]])
+
+
+def footprints(truth: GroundTruth, pedestrian_size: float) -> tuple[np.ndarray, np.ndarray]:
+    """The robot's and the pedestrian's footprints (world frame) at one frame."""
+    r = truth.robot
+    robot = rectangle(r.position, r.yaw, r.length, r.width)
+    ped = rectangle(truth.position_world, truth.heading_world, pedestrian_size, pedestrian_size)
+    return robot, ped
+
+
+def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
+    ab = b - a
+    t = float(np.clip((p - a) @ ab / max(float(ab @ ab), 1e-18), 0.0, 1.0))
+    return float(np.linalg.norm(p - (a + t * ab)))
+
+
+def _inside(p: np.ndarray, poly: np.ndarray) -> bool:
+    """Point in a convex counter-clockwise polygon (boundary included)."""
+    for a, b in zip(poly, np.roll(poly, -1, axis=0), strict=True):
+        if (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) < -1e-12:
+            return False
+    return True
+
+
+def polygon_gap(a: np.ndarray, b: np.ndarray) -> float:
+    """Distance between two convex polygons (counter-clockwise corners), 0 when they overlap."""
+    if any(_inside(p, b) for p in a) or any(_inside(p, a) for p in b):
+        return 0.0
+    gap = math.inf
+    for poly, other in ((a, b), (b, a)):
+        edges = list(zip(other, np.roll(other, -1, axis=0), strict=True))
+        for p in poly:
+            gap = min(gap, min(_segment_distance(p, e0, e1) for e0, e1 in edges))
+    if gap > 0:  # edges crossing without a corner inside: a '+' shaped overlap
+        for p0, p1 in zip(a, np.roll(a, -1, axis=0), strict=True):
+            for q0, q1 in zip(b, np.roll(b, -1, axis=0), strict=True):
+                if _segments_cross(p0, p1, q0, q1):
+                    return 0.0
+    return gap
+
+
+def _segments_cross(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> bool:
+    def side(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> float:
+        return float((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+
+    return side(p0, p1, q0) * side(p0, p1, q1) < 0 and side(q0, q1, p0) * side(q0, q1, p1) < 0
+
+
+def footprint_gap(truth: GroundTruth, pedestrian_size: float) -> float:
+    """Metres between the robot's and the pedestrian's footprints (0 in contact)."""
+    return polygon_gap(*footprints(truth, pedestrian_size))
+
+
+# -- the layout ----------------------------------------------------------------------
+
+
+def sim_blueprint() -> rrb.Blueprint:
+    """Camera big on the left; 3D world over the top-down view on the right; plots below."""
+    return rrb.Blueprint(
+        rrb.Vertical(
+            rrb.Horizontal(
+                rrb.Spatial2DView(origin="camera", name="robot camera: pipeline and truth"),
+                rrb.Vertical(
+                    rrb.Spatial3DView(origin="world", name="world (3D): truth and ground mode"),
+                    rrb.Spatial2DView(origin="topdown", name="highway-env top-down"),
+                    row_shares=[3, 2],
+                ),
+                column_shares=[3, 2],
+            ),
+            rrb.Horizontal(
+                rrb.Vertical(
+                    rrb.TimeSeriesView(
+                        origin="/",
+                        contents=["features/phi", "truth/phi"],
+                        name="phi (deg): estimated vs true",
+                    ),
+                    rrb.TimeSeriesView(
+                        origin="features",
+                        contents=["features/vx", "features/vy"],
+                        name="image velocity (px/s)",
+                    ),
+                ),
+                rrb.Vertical(
+                    rrb.TimeSeriesView(origin="ttc", name="time to contact (s)"),
+                    rrb.TimeSeriesView(origin="alarm", name="warning vs true collision (0/1)"),
+                ),
+                rrb.Vertical(
+                    rrb.TimeSeriesView(
+                        origin="/",
+                        contents=["robot/speed", "truth/gap"],
+                        name="robot speed (m/s), footprint gap (m)",
+                    ),
+                    rrb.TimeSeriesView(origin="latency", name="latency (ms)"),
+                ),
+                rrb.TextLogView(origin="events", name="events"),
+                column_shares=[1, 1, 1, 1],
+            ),
+            row_shares=[3, 2],
+        ),
+        collapse_panels=True,
+    )
+
+
+# -- highway-env's top-down view -------------------------------------------------------
+
+
+class TopDownCamera:
+    """highway-env's bird's-eye view of a World's road, drawn offscreen.
+
+    sim.env.TopDownViewer wants an environment; it reads only the road, the ego vehicle,
+    the config and the observation type, so a plain namespace carrying the World's own
+    objects stands in for one.
+    """
+
+    def __init__(self, world: World) -> None:
+        from sim.env import PedestrianCrossingEnv, TopDownViewer
+
+        if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+            os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # pygame needs a driver
+        self.world = world
+        config = PedestrianCrossingEnv.default_config()
+        self._host = SimpleNamespace(
+            road=world.road, vehicle=world.robot, config=config, observation_type=None
+        )
+        self._viewer = TopDownViewer(self._host)  # type: ignore[arg-type]
+
+    def render(self) -> np.ndarray:
+        """RGB (H, W, 3) of the current state."""
+        self._host.road, self._host.vehicle = self.world.road, self.world.robot
+        self._viewer.display()
+        return np.ascontiguousarray(self._viewer.get_image())
+
+    def close(self) -> None:
+        self._viewer.close()
+
+
+# -- the recording ---------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class RecordSummary:
+    """What a recorded run amounted to."""
+
+    path: Path
+    frames: int
+    found: int  # frames where the pipeline had a pose
+    contact_time: float | None
+    warned: dict[str, int]  # frames with a warning, per predictor
+    collision_frames: int  # frames with a true collision within the horizon
+    bytes: int
+    missed: tuple[str, ...] = ()  # predictors that never warned while a collision was coming
+    false_alarms: tuple[str, ...] = ()  # predictors that warned in a run without a collision
+
+
+class SimRecording:
+    """One scenario run written to .rrd, frame by frame.
+
+    Call `log_step(step, result)` right after each World step (result: the pipeline's
+    FrameResult for step.frame, or None when the pipeline did not run on it), then
+    `close()` to keep the file or `abort()` to drop it. Use as a context manager to get
+    `abort()` on an exception and `close()` otherwise.
+    """
+
+    def __init__(
+        self,
+        path: Path,
+        world: World,
+        *,
+        topdown_every: int = DEFAULT_TOPDOWN_EVERY,
+        application_id: str = "monopic-sim",
+        recording_id: str | None = None,
+    ) -> None:
+        if topdown_every < 0:
+            raise ValueError(f"topdown_every must be >= 0 (0: none), got {topdown_every}")
+        self.world = world
+        self.scenario: Scenario = world.scenario
+        self.topdown_every = topdown_every
+        self.run = RunRecording(
+            Path(path), application_id, recording_id or self.scenario.name, layout=sim_blueprint()
+        )
+        self.rec = self.run.rec
+        self._topdown: TopDownCamera | None = None
+        self._static_done = False
+        self._robot_trail: list[list[float]] = []
+        self._was_found = False
+        self._was_colliding = False
+        self._contact_logged = False
+        self._warning: dict[str, bool] = {}
+        self._drawn: set[str] = set()  # predictors with a prediction in the world view
+        self._colliding_now = False
+        self.frames = 0
+        self.found = 0
+        self.contact_time: float | None = None
+        self.warned: dict[str, int] = {}
+        self.warned_in_time: dict[str, bool] = {}  # warned on a frame with a true collision
+        self.collision_frames = 0
+        self.primary = ""  # the pipeline's primary predictor, once a result was logged
+
+    @property
+    def path(self) -> Path:
+        return self.run.path
+
+    # -- static parts ------------------------------------------------------------------
+
+    def _log_static(self) -> None:
+        rec, scenario = self.rec, self.scenario
+        rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
+        skeleton = rr.AnnotationContext(
+            rr.ClassDescription(
+                info=rr.AnnotationInfo(id=0, label="pedestrian", color=PEDESTRIAN_COLOUR),
+                keypoint_annotations=[
+                    rr.AnnotationInfo(id=i, label=name) for i, name in enumerate(LANDMARK_NAMES)
+                ],
+                keypoint_connections=list(CONNECTIONS),
+            )
+        )
+        rec.log("world/pedestrian", skeleton, static=True)
+        self._log_road()
+        robot = scenario.robot
+        rec.log(
+            "world/robot/body",
+            rr.Boxes3D(
+                centers=[[0.0, 0.0, ROBOT_BODY_HEIGHT / 2]],
+                half_sizes=[[robot.length / 2, robot.width / 2, ROBOT_BODY_HEIGHT / 2]],
+                colors=[ROBOT_COLOUR],
+                labels=["robot"],
+            ),
+            static=True,
+        )
+        cam = self.world.camera
+        rec.log(
+            "world/robot/camera",
+            rr.Transform3D(translation=cam.position, mat3x3=cam.axes.T),
+            static=True,
+        )
+        rec.log(
+            "world/robot/camera",
+            rr.Pinhole(
+                focal_length=[cam.fx, cam.fy],
+                principal_point=[cam.cx, cam.cy],
+                resolution=[cam.width, cam.height],
+                camera_xyz=rr.ViewCoordinates.RDF,
+                image_plane_distance=1.0,
+            ),
+            static=True,
+        )
+        path = self.world.pedestrian.path if self.world.pedestrian else None
+        if path is not None:
+            times = np.linspace(0.0, scenario.duration, max(2, int(scenario.duration * 10) + 1))
+            pts = np.array([path.state(float(t)).position for t in times])
+            rec.log(
+                "world/truth/path",
+                rr.LineStrips3D(
+                    [np.column_stack([pts, np.full(len(pts), 0.01)])],
+                    colors=[(*TRUTH_COLOUR, 110)],
+                    radii=0.015,
+                ),
+                static=True,
+            )
+        for name, colour, label in (
+            ("truth/phi", TRUTH_COLOUR, "true phi"),
+            ("ttc/truth", TRUTH_COLOUR, "true time to contact"),
+            ("alarm/truth", TRUTH_COLOUR, "true: contact within the horizon"),
+            ("robot/speed", ROBOT_COLOUR, "robot speed"),
+            ("truth/gap", TRUTH_COLOUR, "footprint gap"),
+        ):
+            width = 4.0 if name == "alarm/truth" else 2.0
+            rec.log(name, rr.SeriesLines(names=label, colors=[colour], widths=width), static=True)
+        self._static_done = True
+
+    def _log_road(self) -> None:
+        """Road edges, lane lines, pavements, crossing and parked cars over the run's stretch."""
+        scenario, road = self.scenario, self.scenario.scene.road
+        reach = scenario.robot.speed * scenario.duration + 2 * scenario.robot.length
+        path = self.world.pedestrian.path if self.world.pedestrian else None
+        xs = [0.0, reach]
+        if path is not None:
+            xs += [float(path.state(t).position[0]) for t in (0.0, scenario.duration)]
+        x0, x1 = min(xs) - 5.0, max(xs) + 10.0
+        y_right, y_left = road.edges
+        kerb = 0.15
+        lines, colours = [], []
+        for y in (y_right, y_left):
+            lines.append([[x0, y, 0.0], [x1, y, 0.0]])
+            colours.append((235, 235, 235))
+        for y in (y_right - kerb - road.pavement_width, y_left + kerb + road.pavement_width):
+            lines.append([[x0, y, 0.0], [x1, y, 0.0]])
+            colours.append(ROAD_COLOUR)
+        for k in range(1, road.lanes):
+            y = y_right + k * road.lane_width
+            x = x0
+            while x < x1:  # dashed lane line
+                lines.append([[x, y, 0.0], [min(x + road.dash_length, x1), y, 0.0]])
+                colours.append((200, 200, 200))
+                x += road.dash_length + road.dash_gap
+        if road.crosswalk_x is not None and x0 <= road.crosswalk_x <= x1:
+            cx, h = road.crosswalk_x, road.crosswalk_length / 2
+            lines.append(
+                [
+                    [cx - h, y_right, 0.0],
+                    [cx + h, y_right, 0.0],
+                    [cx + h, y_left, 0.0],
+                    [cx - h, y_left, 0.0],
+                    [cx - h, y_right, 0.0],
+                ]
+            )
+            colours.append((255, 255, 255))
+        self.rec.log("world/road", rr.LineStrips3D(lines, colors=colours, radii=0.03), static=True)
+        occluders = scenario.scene.occluders
+        turn = [rr.RotationAxisAngle(axis=(0, 0, 1), radians=o.yaw) for o in occluders]
+        if occluders:
+            self.rec.log(
+                "world/road/parked_cars",
+                rr.Boxes3D(
+                    centers=[[o.x, o.y, o.height / 2] for o in occluders],
+                    half_sizes=[[o.length / 2, o.width / 2, o.height / 2] for o in occluders],
+                    rotations=turn,
+                    colors=[tuple(int(255 * c) for c in o.colour) for o in occluders],
+                ),
+                static=True,
+            )
+
+    # -- per frame ---------------------------------------------------------------------
+
+    def log_step(self, step: WorldStep, result: FrameResult | None) -> None:
+        """One frame: the camera image, the pipeline's result if any, the truth, the world."""
+        if not self._static_done:
+            self._log_static()
+        rec, truth = self.rec, step.truth
+        self.run.set_time(step.index, step.time)
+        if step.frame is not None:
+            self.run.log_image(step.frame.image)
+        self._colliding_now = truth.collision
+        if result is not None:
+            self.primary = self.primary or result.primary
+            self.run.log_result(result)
+            self._log_decisions(result)
+        self._log_camera_truth(truth)
+        self._log_world(step)
+        self._log_series(truth)
+        self._log_events(step, result)
+        if self.topdown_every and step.index % self.topdown_every == 0 and self.world.road:
+            if self._topdown is None:
+                self._topdown = TopDownCamera(self.world)
+            rec.log("topdown/image", encoded_jpeg(self._topdown.render()))
+        self.frames += 1
+        self.collision_frames += int(truth.collision)
+
+    def log_event(self, text: str, level: str = rr.TextLogLevel.INFO) -> None:
+        """A line in the events view at the current frame (e.g. the closed loop's brake)."""
+        self.rec.log("events", rr.TextLog(text, level=level))
+
+    def log_series(self, entity: str, value: float) -> None:
+        """A scalar at the current frame (e.g. the closed loop's brake command)."""
+        if math.isfinite(value):
+            self.rec.log(entity, rr.Scalars(value))
+
+    def _log_decisions(self, result: FrameResult) -> None:
+        """Every predictor's warning as 0/1; ground mode's prediction in the robot frame."""
+        rec = self.rec
+        drawn = set()
+        feats = result.features
+        for k, d in enumerate(result.decisions):
+            name = entity_name(d.predictor)
+            rec.log(f"alarm/{name}", rr.Scalars(float(d.warning.collision)))
+            if d.warning.time_to_contact is not None:
+                rec.log(f"ttc/{name}", rr.Scalars(d.warning.time_to_contact))
+            warned = d.warning.collision
+            self.warned[d.predictor] = self.warned.get(d.predictor, 0) + int(warned)
+            in_time = self.warned_in_time.get(d.predictor, False)
+            self.warned_in_time[d.predictor] = in_time or (warned and self._colliding_now)
+            ground = d.prediction.ground
+            if d.mode is not Mode.GROUND or ground is None or not (feats and feats.ground):
+                continue
+            g0 = feats.ground.position
+            rec.log(
+                f"world/robot/prediction/{name}",
+                rr.LineStrips3D(
+                    [[[g0[0], g0[1], 0.03], [ground[0], ground[1], 0.03]]],
+                    colors=[PREDICTION_COLOURS[k % len(PREDICTION_COLOURS)]],
+                    radii=0.03,
+                    labels=[d.predictor],
+                ),
+            )
+            drawn.add(name)
+        for name in self._drawn - drawn:  # no ground prediction this frame
+            rec.log(f"world/robot/prediction/{name}", rr.Clear(recursive=False))
+        self._drawn = drawn
+
+    def _log_camera_truth(self, truth: GroundTruth) -> None:
+        rec = self.rec
+        camera = self.world.camera
+        foot = truth.foot_px
+        if truth.in_frame and np.all(np.isfinite(foot)):
+            rec.log(
+                "camera/truth/foot",
+                rr.Points2D([foot], colors=[TRUTH_COLOUR], radii=-5.0, labels=["truth"]),
+            )
+            rec.log(
+                "camera/truth/centre",
+                rr.Points2D([truth.centre_px], colors=[TRUTH_COLOUR], radii=-3.0),
+            )
+            rec.log(
+                "camera/truth/box",
+                rr.Boxes2D(
+                    array=np.array(truth.box),
+                    array_format=rr.Box2DFormat.XYXY,
+                    colors=[TRUTH_COLOUR],
+                ),
+            )
+        else:
+            rec.log("camera/truth", rr.Clear(recursive=True))
+            return
+        future = self._future_path(truth)
+        pose = truth.robot.pose
+        local = pose.to_local(np.column_stack([future, np.zeros(len(future))]))
+        px = camera.project(local)
+        px = px[np.all(np.isfinite(px), axis=1)]
+        if len(px) >= 2:
+            rec.log(
+                "camera/truth/path",
+                rr.LineStrips2D([px], colors=[TRUTH_COLOUR], radii=-1.5),
+            )
+        else:
+            rec.log("camera/truth/path", rr.Clear(recursive=False))
+
+    def _future_path(self, truth: GroundTruth) -> np.ndarray:
+        """World (x, y) of the true path from now to now + horizon."""
+        path = self.world.pedestrian.path if self.world.pedestrian else None
+        if path is None:
+            return np.array([truth.position_world, truth.future_position_world])
+        times = truth.time + np.linspace(0.0, truth.horizon, PATH_SAMPLES)
+        return np.array([path.state(float(t)).position for t in times])
+
+    def _log_world(self, step: WorldStep) -> None:
+        rec, truth, scenario = self.rec, step.truth, self.scenario
+        r = truth.robot
+        rec.log(
+            "world/robot",
+            rr.Transform3D(
+                translation=[float(r.position[0]), float(r.position[1]), 0.0],
+                rotation=rr.RotationAxisAngle(axis=[0, 0, 1], radians=r.yaw),
+            ),
+        )
+        zone = swept_ground_zone(_robot_geometry(scenario), r.speed, scenario.horizon)
+        closed = np.vstack([zone, zone[:1]])
+        rec.log(
+            "world/robot/zone",
+            rr.LineStrips3D(
+                [np.column_stack([closed, np.full(len(closed), 0.02)])],
+                colors=[(240, 60, 60)],
+                radii=0.02,
+            ),
+        )
+        self._robot_trail.append([float(r.position[0]), float(r.position[1]), 0.02])
+        if len(self._robot_trail) >= 2:
+            rec.log(
+                "world/robot_trail",
+                rr.LineStrips3D([self._robot_trail], colors=[ROBOT_COLOUR], radii=0.02),
+            )
+        rec.log(
+            "world/pedestrian",
+            rr.Points3D(
+                truth.body.landmarks_world,
+                class_ids=0,
+                keypoint_ids=np.arange(len(LANDMARK_NAMES)),
+                radii=0.025,
+            ),
+        )
+        _, ped = footprints(truth, scenario.pedestrian.footprint)
+        ring = np.vstack([ped, ped[:1]])
+        rec.log(
+            "world/pedestrian/footprint",
+            rr.LineStrips3D(
+                [np.column_stack([ring, np.full(len(ring), 0.02)])],
+                colors=[PEDESTRIAN_COLOUR],
+                radii=0.02,
+            ),
+        )
+        future = self._future_path(truth)
+        rec.log(
+            "world/truth/future",
+            rr.LineStrips3D(
+                [np.column_stack([future, np.full(len(future), 0.04)])],
+                colors=[TRUTH_COLOUR],
+                radii=0.04,
+                labels=[f"truth +{truth.horizon:g} s"],
+            ),
+        )
+
+    def _log_series(self, truth: GroundTruth) -> None:
+        rec = self.rec
+        rec.log("truth/phi", rr.Scalars(truth.phi))
+        if truth.time_to_collision is not None:
+            rec.log("ttc/truth", rr.Scalars(truth.time_to_collision))
+        rec.log("alarm/truth", rr.Scalars(float(truth.collision)))
+        rec.log("robot/speed", rr.Scalars(truth.robot.speed))
+        rec.log("truth/gap", rr.Scalars(footprint_gap(truth, self.scenario.pedestrian.footprint)))
+
+    def _log_events(self, step: WorldStep, result: FrameResult | None) -> None:
+        truth = step.truth
+        if truth.collision and not self._was_colliding and not truth.contact:
+            ttc = truth.time_to_collision
+            self.log_event(
+                f"truth: on a collision course, contact in {ttc:.2f} s"
+                if ttc is not None
+                else "truth: on a collision course",
+                rr.TextLogLevel.WARN,
+            )
+        self._was_colliding = truth.collision
+        if truth.contact and not self._contact_logged:
+            self.contact_time = truth.time
+            self._contact_logged = True
+            self.log_event(
+                f"CONTACT at {truth.time:.2f} s, robot at {truth.robot.speed:.2f} m/s",
+                rr.TextLogLevel.ERROR,
+            )
+        if result is None:
+            return
+        found = result.pose.found
+        self.found += int(found)
+        if found != self._was_found:
+            self.log_event("pose found" if found else "pose lost", rr.TextLogLevel.DEBUG)
+        self._was_found = found
+        for d in result.decisions:
+            was = self._warning.get(d.predictor, False)
+            if d.warning.collision and not was:
+                self.log_event(f"{d.predictor}: warning on", rr.TextLogLevel.WARN)
+            self._warning[d.predictor] = d.warning.collision
+        for key, was in list(self._warning.items()):
+            if was and result.decision(key) is None:
+                self._warning[key] = False
+
+    # -- finishing -----------------------------------------------------------------------
+
+    def missed(self) -> tuple[str, ...]:
+        """Predictors that never warned on a frame where the footprints would meet in time."""
+        if self.collision_frames == 0:
+            return ()
+        return tuple(p for p in self.warned if not self.warned_in_time.get(p, False))
+
+    def false_alarms(self) -> tuple[str, ...]:
+        """Predictors that warned although no collision was ever coming in this run."""
+        if self.collision_frames > 0:
+            return ()
+        return tuple(p for p, n in self.warned.items() if n > 0)
+
+    def went_wrong(self, predictor: str | None = None) -> bool:
+        """A missed collision or a false alarm of `predictor` (default: the primary one).
+
+        What a sweep keeps by default: `rec.close() if record_all or rec.went_wrong()
+        else rec.abort()`.
+        """
+        key = predictor or self.primary
+        if self.collision_frames > 0:
+            return not self.warned_in_time.get(key, False)
+        return self.warned.get(key, 0) > 0
+
+    def summary(self) -> RecordSummary:
+        size = self.path.stat().st_size if self.path.exists() else 0
+        return RecordSummary(
+            self.path,
+            self.frames,
+            self.found,
+            self.contact_time,
+            dict(self.warned),
+            self.collision_frames,
+            size,
+            self.missed(),
+            self.false_alarms(),
+        )
+
+    def close(self) -> RecordSummary:
+        """Finish the file and move it into place."""
+        self._close_topdown()
+        self.run.close()
+        return self.summary()
+
+    def abort(self) -> None:
+        """Drop the recording (e.g. a sweep run that went right)."""
+        self._close_topdown()
+        self.run.abort()
+
+    def _close_topdown(self) -> None:
+        if self._topdown is not None:
+            self._topdown.close()
+            self._topdown = None
+
+    def __enter__(self) -> SimRecording:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()
+
+
+# sim.runner is imported where it is used: the runner records through this module.
+
+
+def _robot_geometry(scenario: Scenario) -> RobotGeometry:
+    """The footprint the pipeline's warning uses (the runner's, so the zone drawn is its zone)."""
+    from sim.runner import robot_geometry
+
+    return robot_geometry(scenario)
+
+
+def default_pipeline(scenario: Scenario) -> Pipeline:
+    """The sweep's pipeline (sim.runner.make_pipeline): every predictor, both modes."""
+    from sim.runner import make_pipeline
+
+    return make_pipeline(scenario)
+
+
+def record_run(
+    scenario: Scenario,
+    path: Path,
+    *,
+    pipeline: Pipeline | None = None,
+    topdown_every: int = DEFAULT_TOPDOWN_EVERY,
+    stop_at_contact: bool = True,
+    on_frame: Callable[[int], None] | None = None,
+) -> RecordSummary:
+    """Run one scenario through the pipeline, frame by frame, and record it to `path`."""
+    pipeline = pipeline or default_pipeline(scenario)
+    with World(scenario, render=True) as world:
+        recording = SimRecording(path, world, topdown_every=topdown_every)
+        with recording:
+            step = world.reset()
+            for k in range(scenario.frames):
+                if k > 0:
+                    step = world.step()
+                assert step.frame is not None
+                recording.log_step(step, pipeline.process(step.frame))
+                if on_frame is not None:
+                    on_frame(k)
+                if stop_at_contact and step.truth.contact:
+                    break
+        return recording.summary()

@@ -1,0 +1,204 @@
+"""Synthetic datasets: the spec loader, the COCO files (against pycocotools when installed),
+masks, keypoints, truth and feature files, determinism and resuming."""
+
+from __future__ import annotations
+
+import csv
+import json
+import shutil
+from pathlib import Path
+
+import cv2
+import numpy as np
+import pytest
+
+from monopic.errors import UserError
+from monopic.replay.logs import read_log
+from sim.coco import (
+    COCO17_FROM_BLAZEPOSE,
+    COCO17_NAMES,
+    decode_mask,
+    encode_mask,
+    read_coco,
+    rle_counts,
+)
+from sim.dataset import build, expand, load_spec
+
+TINY = """\
+name = "tiny"
+description = "two short runs for the tests"
+seed = 7
+duration = 0.5
+fps = 15
+[camera]
+width = 384
+height = 216
+[grid]
+cases = [5, 6]
+distances = [4.5]
+robot_speeds = [1.0]
+"""
+TIMING_COLUMNS = ("detectMs", "landmarksMs", "featuresMs", "predictMs", "warningMs", "totalMs")
+
+
+def write_spec(folder: Path, text: str = TINY) -> Path:
+    path = folder / "tiny.toml"
+    path.write_text(text)
+    return path
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory) -> tuple[Path, Path, dict]:
+    folder = tmp_path_factory.mktemp("ds")
+    spec = write_spec(folder)
+    out = folder / "out"
+    counts = build(load_spec(spec), out, report=lambda _: None)
+    return spec, out, counts
+
+
+# -- the spec ------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("change", "expected"),
+    [
+        (("cases = [5, 6]", "cases = [5, 10]"), "grid.cases = 10: must be <= 9"),
+        (("cases = [5, 6]", 'cases = "5"'), "grid.cases = '5': must be a non-empty list"),
+        (("fps = 15", "fps = 15\ncolour = 3"), "colour = 3: unknown key"),
+        (("robot_speeds = [1.0]", "robot_speeds = [1.0, 1.0]"), "lists a value twice"),
+        (("[camera]", "[camera]\nwidth_px = 3"), "camera.width_px = 3: unknown key"),
+        (('name = "tiny"', 'name = "a b"'), "name = 'a b': must be a non-empty name"),
+        (("seed = 7", "seed = -1"), "seed = -1: must be between"),
+    ],
+)
+def test_spec_errors_name_file_field_and_value(tmp_path, change, expected):
+    path = write_spec(tmp_path, TINY.replace(*change))
+    with pytest.raises(UserError) as err:
+        load_spec(path)
+    message = str(err.value)
+    assert message.startswith(str(path)) and expected in message and "\n" not in message
+
+
+def test_grid_expands_in_a_fixed_order_with_distinct_seeds(tmp_path):
+    spec = load_spec(write_spec(tmp_path, TINY.replace("cases = [5, 6]", "cases = [5, 6, 9]")))
+    runs = expand(spec)
+    assert [r.id for r in runs] == ["r0000", "r0001", "r0002"]
+    assert [r.params["case"] for r in runs] == [5, 6, 9]
+    assert len({r.scenario.seed for r in runs}) == 3
+    assert [r.scenario.seed for r in expand(spec)] == [r.scenario.seed for r in runs]
+    assert runs[2].params["pedestrian_speed"] == 0.0  # standing still
+
+
+def test_rle_round_trip():
+    rng = np.random.default_rng(1)
+    for _ in range(50):
+        mask = rng.random(tuple(rng.integers(1, 30, 2))) < rng.random()
+        assert np.array_equal(decode_mask(encode_mask(mask)), mask)
+        assert sum(rle_counts(mask)) == mask.size
+
+
+# -- the dataset -----------------------------------------------------------------------
+
+
+@pytest.mark.slow
+def test_coco_files_keypoints_and_masks(dataset):
+    _, out, counts = dataset
+    b33 = read_coco(out / "annotations" / "blazepose33.json")
+    c17 = read_coco(out / "annotations" / "coco17.json")
+    assert b33.num_keypoints == 33 and c17.num_keypoints == 17
+    assert c17.category["keypoints"] == list(COCO17_NAMES)
+    assert len(b33.images) == counts["images"] == 2 * 8 and len(b33.annotations) >= 12
+    assert [a["id"] for a in b33.annotations] == [a["id"] for a in c17.annotations]
+    for a33, a17 in zip(b33.annotations, c17.annotations, strict=True):
+        k33, k17 = b33.keypoints(a33), c17.keypoints(a17)
+        assert np.array_equal(k17, k33[list(COCO17_FROM_BLAZEPOSE)])
+        assert set(k33[:, 2]) <= {0, 1, 2}
+        assert a33["num_keypoints"] == int((k33[:, 2] > 0).sum())
+        mask = b33.mask(a33)
+        assert mask.sum() == a33["area"] > 0  # an annotation only where the person shows
+        png = cv2.imread(str(out / b33.images[a33["image_id"]]["mask_file"]), cv2.IMREAD_GRAYSCALE)
+        assert np.array_equal(png > 0, mask)
+        x, y, w, h = a33["bbox"]
+        ys, xs = np.nonzero(mask)
+        assert (x, y, w, h) == (
+            xs.min(),
+            ys.min(),
+            xs.max() + 1 - xs.min(),
+            ys.max() + 1 - ys.min(),
+        )
+        # In-view keypoints lie on the image, mostly near the mask.
+        seen = k33[k33[:, 2] == 2]
+        assert np.all((seen[:, 0] >= 0) & (seen[:, 0] < 384) & (seen[:, 1] < 216))
+    # A person fully in view gets an annotation on every frame.
+    truth = [json.loads(line) for p in sorted((out / "truth").glob("*.jsonl"))
+             for line in p.read_text().splitlines()]  # fmt: skip
+    in_view = {t["image"] for t in truth if t["in_frame"] and t["visible_fraction"] == 1.0}
+    annotated = {b33.images[a["image_id"]]["file_name"] for a in b33.annotations}
+    assert in_view and in_view <= annotated
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("ignore::DeprecationWarning")  # pycocotools 2.0.11 on numpy 2
+def test_pycocotools_reads_what_our_reader_reads(dataset):
+    coco_module = pytest.importorskip("pycocotools.coco")
+    _, out, _ = dataset
+    for name in ("blazepose33", "coco17"):
+        ours = read_coco(out / "annotations" / f"{name}.json")
+        theirs = coco_module.COCO(str(out / "annotations" / f"{name}.json"))
+        assert sorted(theirs.getImgIds()) == sorted(ours.images)
+        ann_ids = theirs.getAnnIds(catIds=[1])
+        assert len(ann_ids) == len(ours.annotations)
+        for ann in ours.annotations:
+            ref = theirs.loadAnns([ann["id"]])[0]
+            assert np.array_equal(theirs.annToMask(ref).astype(bool), ours.mask(ann))
+            assert ref["keypoints"] == ann["keypoints"]
+
+
+@pytest.mark.slow
+def test_truth_rows_and_features_in_the_authors_format(dataset):
+    _, out, counts = dataset
+    rows = list(csv.DictReader((out / "frames.csv").open()))
+    assert len(rows) == counts["images"]
+    assert {r["case"] for r in rows} == {"5", "6"}  # perpendicular right, left
+    runs = list(csv.DictReader((out / "runs.csv").open()))
+    assert [r["run"] for r in runs] == ["r0000", "r0001"]
+    for path in sorted((out / "features").glob("*.csv")):
+        log = read_log(path)  # the authors' log reader accepts it
+        assert len(log) >= 5
+    card = (out / "README.md").read_text()
+    assert "## Licence" in card and "CC-BY-4.0" in card and f"| runs | {counts['runs']} |" in card
+
+
+def _without_timing(path: Path) -> list[list[str]]:
+    rows = list(csv.reader(path.open()))
+    keep = [i for i, name in enumerate(rows[0]) if name not in TIMING_COLUMNS]
+    return [[r[i] for i in keep] for r in rows]
+
+
+def _files(folder: Path) -> dict[str, bytes]:
+    return {
+        str(p.relative_to(folder)): p.read_bytes()
+        for p in sorted(folder.rglob("*"))
+        if p.is_file() and p.parts[len(folder.parts)] != "features"
+    }
+
+
+@pytest.mark.slow
+def test_deterministic_and_resumable(dataset, tmp_path):
+    spec_path, out, _ = dataset
+    spec = load_spec(spec_path)
+    # Resume: a run whose record is gone is rendered again, the finished one is skipped.
+    again = tmp_path / "again"
+    shutil.copytree(out, again)
+    (again / "runs" / "r0001.json").unlink()
+    (again / "images" / "r0001" / "0003.jpg").unlink()
+    messages: list[str] = []
+    build(spec, again, report=messages.append)
+    assert any("1 of 2 runs already finished, 1 to render" in m for m in messages)
+    assert _files(again) == _files(out)
+    for path in sorted((out / "features").glob("*.csv")):
+        assert _without_timing(path) == _without_timing(again / "features" / path.name)
+    # Another spec may not write into the same folder.
+    other = load_spec(write_spec(tmp_path, TINY.replace("seed = 7", "seed = 8")))
+    with pytest.raises(UserError, match="made from another spec"):
+        build(other, again, report=lambda _: None)
