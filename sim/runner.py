@@ -19,6 +19,7 @@ import platform
 import time
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -62,6 +63,10 @@ class RunSpec:
     sweep: str = ""
     ablation: bool = True
     stop_at_contact: bool = True
+    # .rrd recordings: "failed" keeps runs where the primary predictor missed a collision
+    # or raised a false alarm, "all" keeps every run, "none" records nothing.
+    record: str = "none"
+    record_dir: str = ""
 
 
 def robot_geometry(scenario: Scenario) -> RobotGeometry:
@@ -255,7 +260,9 @@ def run(spec: RunSpec, on_frame: Callable[[int], None] | None = None) -> dict[st
     crop_log = PipelineLog() if ablation is not None else None
     sim_ms: list[float] = []
     contact_time = None
+    recording_path = None
     with World(scenario, render=True) as world:
+        recording = _start_recording(spec, world)
         t0 = time.perf_counter()
         step = world.reset()
         for k in range(scenario.frames):
@@ -265,7 +272,10 @@ def run(spec: RunSpec, on_frame: Callable[[int], None] | None = None) -> dict[st
             sim_ms.append((time.perf_counter() - t0) * 1e3)
             assert step.frame is not None
             truth_log.add(step.truth)
-            main_log.add(main.process(step.frame))
+            result = main.process(step.frame)
+            main_log.add(result)
+            if recording is not None:
+                recording.log_step(step, result)
             if ablation is not None and crop_log is not None:
                 region = truth_region(step.truth)
                 crop_log.add(ablation.process(step.frame, region) if region else None)
@@ -275,6 +285,12 @@ def run(spec: RunSpec, on_frame: Callable[[int], None] | None = None) -> dict[st
                 contact_time = step.truth.time
                 if spec.stop_at_contact:
                     break
+        if recording is not None:
+            if spec.record == "all" or recording.went_wrong():
+                recording.close()
+                recording_path = recording_name(spec)
+            else:
+                recording.abort()
     pipelines = {"main": main_log.outputs()}
     timing_ms = {"main": main_log.ms}
     if crop_log is not None:
@@ -293,6 +309,7 @@ def run(spec: RunSpec, on_frame: Callable[[int], None] | None = None) -> dict[st
         "scenario": scenario_summary(scenario),
         "frames": len(truth_log.cols["t"]),
         "contact_time": contact_time,
+        "recording": recording_path,
         "truth": truth_log.cols,
         "pipelines": pipelines,
         "timing": {
@@ -302,6 +319,24 @@ def run(spec: RunSpec, on_frame: Callable[[int], None] | None = None) -> dict[st
             "machine": machine(),
         },
     }
+
+
+def _start_recording(spec: RunSpec, world: World):
+    """The run's .rrd recording when the spec asks for one (imported lazily: rerun-heavy)."""
+    if spec.record == "none":
+        return None
+    if spec.record not in ("failed", "all"):
+        raise ValueError(f"record must be none, failed or all, got {spec.record!r}")
+    from sim.recording import SimRecording
+
+    path = Path(spec.record_dir or "recordings") / recording_name(spec)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return SimRecording(path, world)
+
+
+def recording_name(spec: RunSpec) -> str:
+    """The run's recording, relative to the sweep's recordings folder (ids nest by family)."""
+    return f"{spec.id}.rrd"
 
 
 def deterministic_part(result: dict[str, Any]) -> dict[str, Any]:

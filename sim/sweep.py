@@ -195,6 +195,11 @@ class SweepOutcome:
 Executor = Callable[[Sequence[RunSpec], Callable[[dict[str, Any]], None]], None]
 
 
+def recordings_folder(out: Path, record_dir: Path | None = None) -> Path:
+    """Where a sweep's .rrd recordings go: the given folder or <results>_rrd/ beside it."""
+    return record_dir if record_dir is not None else out.parent / f"{out.stem}_rrd"
+
+
 def run_sweep(
     spec: SweepSpec,
     out: Path,
@@ -202,15 +207,20 @@ def run_sweep(
     ablation: bool | None = None,
     progress: bool = True,
     limit: int | None = None,
+    record: str = "failed",
+    record_dir: Path | None = None,
 ) -> SweepOutcome:
     """Run every run of `spec` missing from `out`, appending each result as it finishes.
 
     `ablation` overrides the spec's flag; `limit` stops after that many new runs (to
-    measure a rate, or to test resuming).
+    measure a rate, or to test resuming). `record` ("failed", "all" or "none") says which
+    runs keep a .rrd recording in `record_dir` (default: beside the results file).
     """
     runs = expand_spec(spec)
     if ablation is not None:
         runs = [replace(r, ablation=ablation) for r in runs]
+    folder = str(recordings_folder(out, record_dir))
+    runs = [replace(r, record=record, record_dir=folder) for r in runs]
     if not out.parent.is_dir():
         raise UserError(f"{out}: its folder {out.parent} does not exist")
     with ResultsWriter(out) as writer:

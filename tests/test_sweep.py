@@ -14,6 +14,7 @@ from sim.executors import local_executor, ray_executor, ray_runtime_env
 from sim.results_file import ResultsWriter, read_rows, scan
 from sim.runner import deterministic_part
 from sim.sweep import expand_spec, load_spec, run_sweep
+from tests.rrd import rows_per_entity
 
 # A 6-frame crossing on a 256x144 camera without buildings: seconds per run.
 SCENARIO = """
@@ -118,6 +119,18 @@ def test_sweep_writes_one_line_per_run_and_resumes_without_loss(
     assert len(row["truth"]["t"]) == n
     for cols in row["pipelines"]["main"]["decisions"].values():
         assert all(len(v) == n for v in cols.values())
+
+    # Runs that went wrong (missed collision, false alarm) keep a recording, the others not.
+    recorded = sorted(r["recording"] for r in read_rows(out) if r["recording"])
+    folder = tmp_path / "results_rrd"
+    assert sorted(str(p.relative_to(folder)) for p in folder.rglob("*.rrd")) == recorded
+
+    # On request every run is recorded, and the file holds the run's frames.
+    everything = tmp_path / "all.jsonl"
+    run_sweep(spec, everything, executor, progress=False, limit=1, record="all")
+    (row,) = read_rows(everything)
+    rrd = tmp_path / "all_rrd" / row["recording"]
+    assert rows_per_entity(rrd)["/camera/image"] == row["frames"]
 
 
 @pytest.mark.slow

@@ -28,6 +28,16 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=None,
         help="also run the ground-truth-crop ablation (default: as the spec says)",
     )
+    p.add_argument(
+        "--record",
+        choices=("failed", "all", "none"),
+        default="failed",
+        help="which runs keep a rerun recording: missed collisions and false alarms "
+        "(default), every run, or none",
+    )
+    p.add_argument(
+        "--recordings", type=Path, help="folder for the .rrd files (default: <out>_rrd/ beside it)"
+    )
     p.add_argument("--limit", type=positive_int, help="run at most this many new runs, then stop")
     p.add_argument("--dry-run", action="store_true", help="expand and check the spec, run nothing")
     p.set_defaults(func=run)
@@ -37,7 +47,7 @@ def run(args: argparse.Namespace) -> int:
     from monopic.errors import UserError
     from sim.executors import local_executor, ray_executor
     from sim.results_file import scan
-    from sim.sweep import expand_spec, load_spec, run_sweep
+    from sim.sweep import expand_spec, load_spec, recordings_folder, run_sweep
 
     if args.address and args.executor != "ray":
         raise UserError("--address is for --executor ray")
@@ -56,7 +66,15 @@ def run(args: argparse.Namespace) -> int:
         executor = ray_executor(args.address)
     else:
         executor = local_executor(args.workers)
-    outcome = run_sweep(spec, out, executor, ablation=args.ablation, limit=args.limit)
+    outcome = run_sweep(
+        spec,
+        out,
+        executor,
+        ablation=args.ablation,
+        limit=args.limit,
+        record=args.record,
+        record_dir=args.recordings,
+    )
     rate = outcome.finished / outcome.seconds if outcome.seconds > 0 else 0.0
     print(
         f"{outcome.finished} runs finished in {outcome.seconds:.0f} s "
@@ -64,6 +82,8 @@ def run(args: argparse.Namespace) -> int:
         f"{len(outcome.failed)} failed; {outcome.total} in the sweep"
     )
     print(f"results: {out}  (report: monopic report {out})")
+    if args.record != "none":
+        print(f"recordings ({args.record} runs): {recordings_folder(out, args.recordings)}")
     for run_id, error in outcome.failed[:3]:
         print(f"failed {run_id}:\n{error}")
     return 1 if outcome.failed else 0
