@@ -33,11 +33,9 @@ from pathlib import Path
 import gymnasium
 import numpy as np
 
-from monopic.pipeline import Pipeline, PipelineConfig
-from monopic.pose.tracker import TrackerConfig
+from monopic.pipeline import Pipeline
 from monopic.predict.base import Mode
 from monopic.predictors import make_predictor
-from monopic.variants.warning import CollisionWarning
 from sim.env import ENV_ID
 from sim.recording import SimRecording, footprint_gap
 from sim.scenario import Scenario
@@ -115,18 +113,12 @@ class LatencyBrake:
 
 def policy_pipeline(scenario: Scenario, policy: str) -> Pipeline:
     """A pipeline whose primary (only) predictor is the policy's, e.g. 'rules/ground'."""
-    from sim.runner import robot_geometry
+    from sim.runner import scenario_pipeline
 
     name, _, mode = policy.partition("/")
     if mode not in {m.value for m in Mode}:
         raise ValueError(f"policy {policy!r}: expected 'none', 'truth' or PREDICTOR/MODE")
-    config = PipelineConfig(
-        horizon=scenario.horizon,
-        mode=Mode(mode),
-        tracker=TrackerConfig(threads=1),
-        warning=CollisionWarning(robot=robot_geometry(scenario)),
-    )
-    return Pipeline(config, make_predictor(name, Mode(mode)))
+    return scenario_pipeline(scenario, [make_predictor(name, Mode(mode))])
 
 
 def run_closed_loop(

@@ -53,11 +53,9 @@ from monopic.errors import UserError
 from monopic.framelog import AUTHORS_COLUMNS, frame_row
 from monopic.framelog import FRAME_COLUMNS as FEATURE_COLUMNS
 from monopic.output import atomic_path, write_text_atomically
-from monopic.pipeline import Pipeline, PipelineConfig
-from monopic.pose.tracker import TrackerConfig
+from monopic.pipeline import Pipeline
 from monopic.predict.base import Mode
 from monopic.predict.rules import RulePredictor
-from monopic.variants.warning import CollisionWarning
 from sim.cases import OBLIQUE_RANGE_DEG, place_case
 from sim.coco import SKELETONS, category, encode_mask, mask_box, select_keypoints
 from sim.ground_truth import GroundTruth
@@ -330,15 +328,9 @@ def expand(spec: DatasetSpec) -> list[DatasetRun]:
 
 def dataset_pipeline(scenario: Scenario) -> Pipeline:
     """The paper's image-mode pipeline (rule cascade) whose features the CSV holds."""
-    from sim.runner import robot_geometry
+    from sim.runner import scenario_pipeline
 
-    config = PipelineConfig(
-        horizon=scenario.horizon,
-        mode=Mode.IMAGE,
-        tracker=TrackerConfig(threads=1),
-        warning=CollisionWarning(robot=robot_geometry(scenario)),
-    )
-    return Pipeline(config, RulePredictor(mode=Mode.IMAGE))
+    return scenario_pipeline(scenario, [RulePredictor(mode=Mode.IMAGE)])
 
 
 def keypoints33(truth: GroundTruth, width: int, height: int) -> list[float]:

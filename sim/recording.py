@@ -44,8 +44,9 @@ from monopic.pipeline import FrameResult, Pipeline
 from monopic.pose.skeleton import CONNECTIONS, LANDMARK_NAMES
 from monopic.predict.base import Mode
 from monopic.recording import RunRecording, encoded_jpeg
-from monopic.variants.zone import RobotGeometry, swept_ground_zone
+from monopic.variants.zone import swept_ground_zone
 from sim.ground_truth import GroundTruth
+from sim.runner import make_pipeline, robot_geometry
 from sim.scenario import Scenario
 from sim.world import World, WorldStep
 
@@ -516,7 +517,7 @@ class SimRecording:
                 rotation=rr.RotationAxisAngle(axis=[0, 0, 1], radians=r.yaw),
             ),
         )
-        zone = swept_ground_zone(_robot_geometry(scenario), r.speed, scenario.horizon)
+        zone = swept_ground_zone(robot_geometry(scenario), r.speed, scenario.horizon)
         closed = np.vstack([zone, zone[:1]])
         rec.log(
             "world/robot/zone",
@@ -675,23 +676,6 @@ class SimRecording:
             self.abort()
 
 
-# sim.runner is imported where it is used: the runner records through this module.
-
-
-def _robot_geometry(scenario: Scenario) -> RobotGeometry:
-    """The footprint the pipeline's warning uses (the runner's, so the zone drawn is its zone)."""
-    from sim.runner import robot_geometry
-
-    return robot_geometry(scenario)
-
-
-def default_pipeline(scenario: Scenario) -> Pipeline:
-    """The sweep's pipeline (sim.runner.make_pipeline): every predictor, both modes."""
-    from sim.runner import make_pipeline
-
-    return make_pipeline(scenario)
-
-
 def record_run(
     scenario: Scenario,
     path: Path,
@@ -702,7 +686,7 @@ def record_run(
     on_frame: Callable[[int], None] | None = None,
 ) -> RecordSummary:
     """Run one scenario through the pipeline, frame by frame, and record it to `path`."""
-    pipeline = pipeline or default_pipeline(scenario)
+    pipeline = pipeline or make_pipeline(scenario)
     with World(scenario, render=True) as world:
         recording = SimRecording(path, world, topdown_every=topdown_every)
         with recording:

@@ -17,7 +17,7 @@ import math
 import os
 import platform
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -27,7 +27,7 @@ import numpy as np
 from monopic.pipeline import FrameResult, Pipeline, PipelineConfig
 from monopic.pose.region import Region
 from monopic.pose.tracker import TrackerConfig
-from monopic.predict.base import Mode
+from monopic.predict.base import Mode, Predictor
 from monopic.predictors import make_predictor
 from monopic.variants.warning import CollisionWarning
 from monopic.variants.zone import RobotGeometry
@@ -75,25 +75,34 @@ def robot_geometry(scenario: Scenario) -> RobotGeometry:
     return RobotGeometry(width=robot.width, length=robot.length, front=robot.length / 2)
 
 
+def scenario_pipeline(
+    scenario: Scenario, predictors: Sequence[Predictor], tracker: TrackerConfig | None = None
+) -> Pipeline:
+    """A pipeline set up for the scenario: its horizon and the robot's own footprint.
+
+    One onnxruntime thread by default, since workers run side by side.
+    """
+    config = PipelineConfig(
+        horizon=scenario.horizon,
+        mode=predictors[0].mode,
+        tracker=tracker or TrackerConfig(threads=1),
+        warning=CollisionWarning(robot=robot_geometry(scenario)),
+    )
+    return Pipeline(config, predictors)
+
+
 def make_pipeline(scenario: Scenario, ablation: bool = False) -> Pipeline:
-    """All predictors on one pose; one onnxruntime thread (workers run side by side).
+    """All predictors on one pose, the sweep's pipeline.
 
     The ablation's tracker never detects (a threshold above any score, and no tiles so a
     failed crop costs one whole-frame pass): it only ever sees the true crop, so what it
     gets right or wrong is the pose from that crop.
     """
     tracker = (
-        TrackerConfig(threads=1, min_detection_score=1.01, acquire_tiles=())
-        if ablation
-        else TrackerConfig(threads=1)
+        TrackerConfig(threads=1, min_detection_score=1.01, acquire_tiles=()) if ablation else None
     )
-    config = PipelineConfig(
-        horizon=scenario.horizon,
-        mode=Mode.IMAGE,
-        tracker=tracker,
-        warning=CollisionWarning(robot=robot_geometry(scenario)),
-    )
-    return Pipeline(config, [make_predictor(name, mode) for name, mode in PREDICTORS])
+    predictors = [make_predictor(name, mode) for name, mode in PREDICTORS]
+    return scenario_pipeline(scenario, predictors, tracker)
 
 
 def truth_region(truth: GroundTruth) -> Region | None:
