@@ -2,7 +2,10 @@
 
 Acquire: run the detector on the whole frame, then on square tiles of decreasing size
 until someone is found (far pedestrians are too small for the whole frame squeezed into
-224 px); keep the most confident detection. Track: crop the rotated region, run the
+224 px); keep the most confident detection. The tiles cost one detector pass each (27 at
+768x432, about 380 ms on one core), so a frame spends at most `search_budget` passes:
+the whole frame every time (near pedestrians are found at once) and the next tiles of the
+cascade, which resumes where the previous frame stopped. Track: crop the rotated region, run the
 landmark model, take the next frame's region from this frame's auxiliary points. When the
 pose flag drops, the person is lost and the detector runs again (in the same frame).
 """
@@ -28,6 +31,16 @@ class TrackerConfig:
     # Square tile sides tried, in order, after the whole frame finds nobody.
     acquire_tiles: tuple[int, ...] = (432, 288, 216)
     tile_overlap: float = 0.25
+    # Detector passes per frame while searching: the whole frame + (budget - 1) tiles of
+    # the cascade. 0 runs the whole cascade in every frame (offline, no time limit).
+    search_budget: int = 4
+
+    def __post_init__(self) -> None:
+        if self.search_budget < 0 or self.search_budget == 1 and self.acquire_tiles:
+            raise ValueError(
+                f"search_budget must be 0 (no limit) or >= 2 when tiles are used, "
+                f"got {self.search_budget}"
+            )
 
 
 @dataclass(frozen=True)
@@ -52,10 +65,12 @@ class PoseTracker:
         self.detector = PoseDetector(self.config.threads, self.config.min_detection_score)
         self.landmarks = LandmarkModel(self.config.threads)
         self._region: Region | None = None
+        self._next_tile = 0  # where the search resumes in the tile cascade
 
     def reset(self) -> None:
         """Forget the tracked person (e.g. at a cut in the video)."""
         self._region = None
+        self._next_tile = 0
 
     def process(self, image: np.ndarray, region: Region | None = None) -> PoseResult:
         """Landmarks of the tracked person in this RGB frame.
@@ -88,19 +103,29 @@ class PoseTracker:
 
     def _acquire(self, image: np.ndarray) -> tuple[Region | None, int]:
         h, w = image.shape[:2]
-        levels: list[list[Window]] = [[Window(0, 0, w, h)]]
-        for tile in self.config.acquire_tiles:
-            if tile < max(w, h):
-                levels.append(tile_windows(w, h, tile, self.config.tile_overlap))
+        cfg = self.config
+        levels = [
+            tile_windows(w, h, t, cfg.tile_overlap) for t in cfg.acquire_tiles if t < max(w, h)
+        ]
+        tiles = [win for level in levels for win in level]
+        batches: list[list[Window]] = [[Window(0, 0, w, h)]]
+        if cfg.search_budget == 0:
+            batches += levels  # coarse to fine, stop at the first level that finds someone
+        elif tiles:
+            start = self._next_tile % len(tiles)
+            take = min(cfg.search_budget - 1, len(tiles))
+            batches.append([tiles[(start + k) % len(tiles)] for k in range(take)])
+            self._next_tile = (start + take) % len(tiles)
         runs = 0
-        for windows in levels:
+        for windows in batches:
             runs += len(windows)
             dets = self.detector.detect(image, windows)
             if dets:
                 best = dets[0]
                 region = Region.from_keypoints(
-                    tuple(best.keypoints[0]), tuple(best.keypoints[1]), self.config.region_scale
+                    tuple(best.keypoints[0]), tuple(best.keypoints[1]), cfg.region_scale
                 )
                 if region.valid:
+                    self._next_tile = 0
                     return region, runs
         return None, runs
