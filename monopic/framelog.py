@@ -6,6 +6,8 @@ read our runs; ours add the case, foot and ground points and per-stage milliseco
 
 from __future__ import annotations
 
+import math
+
 from monopic.pipeline import FrameResult
 from monopic.pose.skeleton import LEFT_SHOULDER, RIGHT_SHOULDER
 from monopic.predict.rules import IMAGE_DEAD_ZONE_PX_S
@@ -53,3 +55,14 @@ def frame_row(r: FrameResult, fps: float, horizon: float) -> list:
         f"{ms.get('features', nan):.3f}", f"{ms.get('predict', nan):.3f}",
         f"{ms.get('warning', nan):.3f}", f"{ms.get('total', nan):.3f}",
     ]  # fmt: skip
+
+
+def authors_finite(row: list) -> bool:
+    """Whether a row's authors' columns are all finite numbers, as their log reader demands.
+
+    Not so on a track's first frame (no velocity yet): logs leave such rows out.
+    """
+    try:
+        return all(math.isfinite(float(v)) for v in row[: len(AUTHORS_COLUMNS)])
+    except ValueError:
+        return False

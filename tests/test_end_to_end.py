@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from monopic.pipeline import Pipeline
+from monopic.replay.logs import read_log
 from monopic.video import VideoSource
 from tests.rrd import column, rows_per_entity
 
@@ -64,6 +65,7 @@ def test_video_command_writes_video_csv_and_recording(tmp_path):
     rows = list(csv.DictReader(table.open()))
     assert len(rows) >= 54
     assert {"frameNumber", "angleOfApproach", "predictedX", "case", "totalMs"} <= set(rows[0])
+    assert len(read_log(table)) == len(rows)  # the authors' reader takes every row
     moving = [r for r in rows if r["case"] not in ("", "9")]
     # The mannequin walks from the camera's left to its right.
     assert sum(r["case"] == "5" for r in moving) >= 0.8 * len(moving)

@@ -15,7 +15,7 @@ from monopic.camera import CameraModel
 from monopic.cli.args import non_negative_float, positive_float, positive_int
 from monopic.errors import UserError
 from monopic.frame import EgoState
-from monopic.framelog import FRAME_COLUMNS, frame_row
+from monopic.framelog import FRAME_COLUMNS, authors_finite, frame_row
 from monopic.output import atomic_path
 from monopic.overlay import draw
 from monopic.pipeline import Pipeline, PipelineConfig, Variant
@@ -101,7 +101,9 @@ def run(args: argparse.Namespace) -> int:
                     annotated = draw(frame.image, result, variant, fps_now)
                     writer.write(cv2.cvtColor(annotated, cv2.COLOR_RGB2BGR))
                 if csv_writer is not None and result.features is not None:
-                    csv_writer.writerow(frame_row(result, fps_now, args.horizon))
+                    row = frame_row(result, fps_now, args.horizon)
+                    if authors_finite(row):
+                        csv_writer.writerow(row)
                 if recording is not None:
                     recording.log_frame(frame.image, result)
         except BaseException:
