@@ -1,8 +1,10 @@
 """Synthetic datasets: scenario runs rendered into images, COCO keypoints, masks and truth rows.
 
-A dataset spec (scenarios/datasets/*.toml, see scenarios/datasets/README.md) lists grids
-of sim.cases.place_case parameters; every combination is one run of the simulated world,
-every frame of a run one image. For each run the folder gets:
+A dataset spec (see scenarios/datasets/README.md) is either a case grid ([grid]: every
+combination of sim.cases.place_case parameters is one run) or a sweep spec ([[include]]:
+the runs sim.sweep expands it into, with the sweep's run ids, scenarios and seeds; the ids
+hold a slash, so the per-run files below nest a folder deeper). Every frame of a run is
+one image. For each run the folder gets:
 
 - images/<run>/<frame>.jpg: the robot camera's frame (JPEG, quality 90);
 - masks/<run>/<frame>.png: the pedestrian's pixels from MuJoCo's segmentation rendering
@@ -24,8 +26,9 @@ object, 2 in view; RLE masks), frames.csv (one row per image), runs.csv and READ
 (the card: what, how, counts, licence).
 
 Deterministic for a spec: the run seeds (the gait phase) derive from the spec's seed and
-the run's index, the renderer and the pose models are deterministic on one machine; only
-the measured-time columns of the features (…Ms) differ between invocations.
+the run's index (a sweep spec: as the sweep derives them), the renderer and the pose
+models are deterministic on one machine; only the measured-time columns of the features
+(…Ms) differ between invocations.
 """
 
 from __future__ import annotations
@@ -36,9 +39,9 @@ import io
 import itertools
 import json
 import math
+import os
 import platform
 import shutil
-import tomllib
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
@@ -60,6 +63,11 @@ from sim.cases import OBLIQUE_RANGE_DEG, place_case
 from sim.coco import SKELETONS, category, encode_mask, mask_box, select_keypoints
 from sim.ground_truth import GroundTruth
 from sim.scenario import CameraSpec, RobotSpec, Scenario
+from sim.scenario_file import Values
+from sim.sweep import SPEC_KEYS as SWEEP_KEYS
+from sim.sweep import Include, SweepSpec, expand_spec
+from sim.sweep import parse_spec as parse_sweep_spec
+from sim.toml_table import MISSING, FieldError, TomlTable, read_toml
 from sim.world import World
 
 FORMAT_VERSION = 1
@@ -72,12 +80,9 @@ DEFAULT_LICENCE = "CC-BY-4.0"
 CAMERA_KEYS = ("width", "height", "vertical_fov_deg", "mount_height", "pitch_deg")
 
 
-class SpecError(UserError):
-    """One bad value in a dataset spec: file, field, value and why."""
-
-    def __init__(self, file: Path, field: str, value: object, reason: str) -> None:
-        self.file, self.field, self.value, self.reason = file, field, value, reason
-        super().__init__(f"{file}: {field} = {value!r}: {reason}")
+DOC = "scenarios/datasets/README.md"
+GRID_KEYS = ("name", "description", "licence", "seed", "duration", "fps", "horizon", "camera",
+             "grid")  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -94,156 +99,130 @@ class Grid:
 
 
 @dataclass(frozen=True)
-class DatasetSpec:
-    path: Path
-    name: str
-    description: str
+class CaseGrid:
+    """The case-grid form's runs: the grid and the settings every one of its runs shares."""
+
     seed: int
-    licence: str
     duration: float
     fps: float
     horizon: float
     camera: CameraSpec
     grid: Grid
+
+
+@dataclass(frozen=True)
+class DatasetSpec:
+    """A dataset spec of either form: which runs (`source`) plus the card's metadata."""
+
+    path: Path
+    name: str
+    description: str
+    licence: str
+    source: CaseGrid | SweepSpec  # a case grid, or a sweep spec's runs as `monopic sweep` has them
     text: str = field(repr=False)  # the file as written, kept in the dataset
+    # Included scenario files (sweep form): their path in the dataset and their text.
+    scenario_files: tuple[tuple[str, str], ...] = ()
 
     @property
     def digest(self) -> str:
-        return hashlib.sha256(self.text.encode()).hexdigest()[:16]
+        """Names what the runs are made from: the spec and (sweep form) its scenario files."""
+        h = hashlib.sha256(self.text.encode())
+        for name, text in self.scenario_files:
+            h.update(f"\0{name}\0{text}".encode())
+        return h.hexdigest()[:16]
 
 
 # -- the spec file -------------------------------------------------------------------
 
 
-class _Table:
-    """Typed, strict reads from one TOML table; leftovers are unknown keys."""
-
-    def __init__(self, path: Path, prefix: str, data: dict[str, Any]) -> None:
-        self.path, self.prefix, self.data = path, prefix, dict(data)
-
-    def name(self, key: str) -> str:
-        return f"{self.prefix}{key}"
-
-    def error(self, key: str, value: object, reason: str) -> SpecError:
-        return SpecError(self.path, self.name(key), value, reason)
-
-    def text(self, key: str, default: str | None = None) -> str:
-        value = self.data.pop(key, default)
-        if value is None:
-            raise SpecError(self.path, self.name(key), None, "is required")
-        if not isinstance(value, str):
-            raise self.error(key, value, "must be a string")
-        return value
-
-    def number(
-        self, key: str, default: float, low: float | None = None, high: float | None = None
-    ) -> float:
-        value = self.data.pop(key, default)
-        return self._check_number(key, value, low, high)
-
-    def _check_number(
-        self, key: str, value: object, low: float | None, high: float | None
-    ) -> float:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise self.error(key, value, "must be a number")
-        v = float(value)
-        if not math.isfinite(v):
-            raise self.error(key, value, "must be finite")
-        if low is not None and v < low:
-            raise self.error(key, value, f"must be >= {low:g}")
-        if high is not None and v > high:
-            raise self.error(key, value, f"must be <= {high:g}")
-        return v
-
-    def integer(self, key: str, default: int, low: int, high: int) -> int:
-        value = self.data.pop(key, default)
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise self.error(key, value, "must be an integer")
-        if not low <= value <= high:
-            raise self.error(key, value, f"must be between {low} and {high}")
-        return value
-
-    def numbers(
-        self, key: str, default: tuple[float, ...] | None, low: float, high: float
-    ) -> tuple[float, ...]:
-        value = self.data.pop(key, default)
-        if value is None:
-            raise SpecError(self.path, self.name(key), None, "is required (a list of numbers)")
-        if not isinstance(value, list | tuple) or not value:
-            raise self.error(key, value, "must be a non-empty list of numbers")
-        out = tuple(self._check_number(key, v, low, high) for v in value)
-        if len(set(out)) != len(out):
-            raise self.error(key, value, "lists a value twice")
-        return out
-
-    def table(self, key: str) -> _Table:
-        value = self.data.pop(key, {})
-        if not isinstance(value, dict):
-            raise self.error(key, value, "must be a table")
-        return _Table(self.path, f"{self.name(key)}.", value)
-
-    def done(self) -> None:
-        for key, value in self.data.items():
-            raise self.error(key, value, "unknown key (see scenarios/datasets/README.md)")
-
-
 def load_spec(path: Path) -> DatasetSpec:
-    """Read and validate a dataset spec; every mistake is a SpecError naming the field."""
+    """Read and validate a dataset spec of either form; every mistake names the field.
+
+    The form follows from the keys: [grid] is a case grid, [[include]] a sweep spec.
+    """
     path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except FileNotFoundError:
-        raise UserError(f"{path}: no such dataset spec") from None
-    except (OSError, UnicodeDecodeError) as err:
-        raise UserError(f"{path}: cannot read: {err}") from None
-    try:
-        data = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as err:
-        raise UserError(f"{path}: not valid TOML: {err}") from None
-    top = _Table(path, "", data)
-    name = top.text("name")
-    if not name or any(c.isspace() or c in "/\\" for c in name):
-        raise top.error("name", name, "must be a non-empty name without spaces or slashes")
+    text, data = read_toml(path, "dataset spec")
+    if _form(path, data) == "sweep":
+        sweep = parse_sweep_spec(path, data, DOC)
+        licence = sweep.licence or DEFAULT_LICENCE
+        files = _scenario_files(sweep)
+        return DatasetSpec(path, sweep.name, sweep.description, licence, sweep, text, files)
+    top = TomlTable(path, "", data, DOC)
+    name = top.slug("name")
     description = top.text("description", "")
-    licence = top.text("licence", DEFAULT_LICENCE)
-    seed = top.integer("seed", 0, 0, 2**31 - 1)
-    duration = top.number("duration", 3.0, 0.2, 60.0)
-    fps = top.number("fps", 15.0, 1.0, 60.0)
-    horizon = top.number("horizon", 1.0, 0.1, 10.0)
+    licence = top.text("licence", DEFAULT_LICENCE, nonempty=True)
+    seed = top.integer("seed", 0, low=0, high=2**31 - 1)
+    duration = top.number("duration", 3.0, low=0.2, high=60.0)
+    fps = top.number("fps", 15.0, low=1.0, high=60.0)
+    horizon = top.number("horizon", 1.0, low=0.1, high=10.0)
     cam_t = top.table("camera")
     base = CameraSpec()
     camera = CameraSpec(
-        width=cam_t.integer("width", base.width, 64, 4096),
-        height=cam_t.integer("height", base.height, 64, 4096),
-        vertical_fov_deg=cam_t.number("vertical_fov_deg", base.vertical_fov_deg, 10.0, 150.0),
-        mount_height=cam_t.number("mount_height", base.mount_height, 0.1, 5.0),
-        pitch_deg=cam_t.number("pitch_deg", base.pitch_deg, -45.0, 45.0),
+        width=cam_t.integer("width", base.width, low=64, high=4096),
+        height=cam_t.integer("height", base.height, low=64, high=4096),
+        vertical_fov_deg=cam_t.number(
+            "vertical_fov_deg", base.vertical_fov_deg, low=10.0, high=150.0
+        ),
+        mount_height=cam_t.number("mount_height", base.mount_height, low=0.1, high=5.0),
+        pitch_deg=cam_t.number("pitch_deg", base.pitch_deg, low=-45.0, high=45.0),
     )
     cam_t.done()
     g = top.table("grid")
-    cases = g.numbers("cases", None, 1, 9)
+    cases = g.numbers("cases", low=1, high=9, nonempty=True, distinct=True)
     if any(c != int(c) for c in cases):
         raise g.error("cases", list(cases), "case numbers are integers 1-9")
-    angles = g.numbers("angles", (45.0,), *OBLIQUE_RANGE_DEG)
     lo, hi = OBLIQUE_RANGE_DEG
-    for a in angles:
+    angles = g.numbers("angles", (45.0,), low=lo, high=hi, nonempty=True, distinct=True)
+    for k, a in enumerate(angles):
         if not lo < a < hi:
-            raise g.error(
-                "angles", a, f"an oblique angle must lie strictly between {lo:.1f} and {hi:.1f}"
-            )
+            strictly = f"an oblique angle must lie strictly between {lo:.1f} and {hi:.1f}"
+            raise FieldError(path, f"grid.angles[{k}]", a, strictly)
+
+    def axis(key: str, default: Any, low: float, high: float) -> tuple[float, ...]:
+        return g.numbers(key, default, low=low, high=high, nonempty=True, distinct=True)
+
     grid = Grid(
         cases=tuple(int(c) for c in cases),
-        distances=g.numbers("distances", None, -50.0, 50.0),
-        lateral_offsets=g.numbers("lateral_offsets", (0.0,), -20.0, 20.0),
-        pedestrian_speeds=g.numbers("pedestrian_speeds", (1.4,), GROUND_DEAD_ZONE_MPS, 8.0),
-        robot_speeds=g.numbers("robot_speeds", (0.0,), 0.0, 20.0),
+        distances=axis("distances", MISSING, -50.0, 50.0),
+        lateral_offsets=axis("lateral_offsets", (0.0,), -20.0, 20.0),
+        pedestrian_speeds=axis("pedestrian_speeds", (1.4,), GROUND_DEAD_ZONE_MPS, 8.0),
+        robot_speeds=axis("robot_speeds", (0.0,), 0.0, 20.0),
         angles=angles,
-        repeats=g.integer("repeats", 1, 1, 1000),
+        repeats=g.integer("repeats", 1, low=1, high=1000),
     )
     g.done()
     top.done()
-    return DatasetSpec(path, name, description, seed, licence, duration, fps, horizon, camera,
-                       grid, text)  # fmt: skip
+    source = CaseGrid(seed, duration, fps, horizon, camera, grid)
+    return DatasetSpec(path, name, description, licence, source, text)
+
+
+def _form(path: Path, data: dict[str, Any]) -> str:
+    """'grid' or 'sweep': which form a dataset spec is, by its keys; else a FieldError."""
+    forms = "[grid] (a case grid) or [[include]] (a sweep spec)"
+    if "grid" in data and "include" in data:
+        both = f"a dataset spec has either {forms}, not both; see {DOC}"
+        raise FieldError(path, "grid", data["grid"], both)
+    if "grid" in data:
+        return "grid"
+    if "include" in data:
+        return "sweep"
+    neither = f"a dataset spec needs {forms}"
+    for key, value in data.items():
+        if key not in GRID_KEYS and key not in SWEEP_KEYS:
+            raise FieldError(path, key, value, f"unknown key, and {neither}; see {DOC}")
+    raise FieldError(path, "grid", MISSING, f"missing, and so is include: {neither}; see {DOC}")
+
+
+def _scenario_files(sweep: SweepSpec) -> tuple[tuple[str, str], ...]:
+    """The scenario files a sweep spec includes, named by their path from the spec's folder
+    (leading ../ dropped), with their text: copied into the dataset, part of its digest."""
+    out: dict[str, str] = {}
+    for include in sweep.includes:
+        for file in include.files:
+            rel = Path(os.path.relpath(file, sweep.path.parent))
+            name = "/".join(part for part in rel.parts if part not in ("..", "."))
+            out[name] = file.read_text(encoding="utf-8")
+    return tuple(out.items())
 
 
 # -- runs --------------------------------------------------------------------------------
@@ -265,12 +244,38 @@ def run_seed(spec_seed: int, index: int) -> int:
 
 
 def expand(spec: DatasetSpec) -> list[DatasetRun]:
-    """Every combination of the grid, in a fixed order (the run ids follow it).
+    """Every run of the dataset, in a fixed order (the run ids follow it)."""
+    if isinstance(spec.source, SweepSpec):
+        return _sweep_runs(spec.source)
+    return _grid_runs(spec, spec.source)
+
+
+def _sweep_runs(sweep: SweepSpec) -> list[DatasetRun]:
+    """The runs `monopic sweep` makes of the spec: its ids, scenarios and seeds."""
+    return [
+        DatasetRun(
+            index,
+            run.id,
+            {
+                "family": run.family,
+                "kind": run.kind,
+                "scale": run.scale,
+                "parameters": run.params,
+                "seed": run.scenario.seed,
+            },
+            run.scenario,
+        )
+        for index, run in enumerate(expand_spec(sweep))
+    ]
+
+
+def _grid_runs(spec: DatasetSpec, source: CaseGrid) -> list[DatasetRun]:
+    """Every combination of the grid.
 
     Axes a case ignores collapse: standing still has no walking speed or angle, only the
     oblique cases use the angle.
     """
-    g = spec.grid
+    g = source.grid
     combos: list[dict[str, Any]] = []
     seen = set()
     for case_n, dist, lat, pspeed, rspeed, angle in itertools.product(
@@ -298,10 +303,10 @@ def expand(spec: DatasetSpec) -> list[DatasetRun]:
                 }
             )
     runs = []
-    robot = replace(RobotSpec(), camera=spec.camera)
+    robot = replace(RobotSpec(), camera=source.camera)
     for index, params in enumerate(combos):
         run_id = f"r{index:04d}"
-        seed = run_seed(spec.seed, index)
+        seed = run_seed(source.seed, index)
         try:
             scenario = place_case(
                 Case(params["case"]),
@@ -310,15 +315,15 @@ def expand(spec: DatasetSpec) -> list[DatasetRun]:
                 pedestrian_speed=params["pedestrian_speed"] or 1.4,
                 robot_speed=params["robot_speed"],
                 angle_deg=params["angle_deg"] or 45.0,
-                duration=spec.duration,
-                dt=1.0 / spec.fps,
-                horizon=spec.horizon,
+                duration=source.duration,
+                dt=1.0 / source.fps,
+                horizon=source.horizon,
                 robot=robot,
                 seed=seed,
                 name=f"{spec.name}-{run_id}",
             )
         except ValueError as err:
-            raise SpecError(spec.path, "grid", params, str(err)) from None
+            raise FieldError(spec.path, "grid", params, str(err)) from None
         runs.append(DatasetRun(index, run_id, {**params, "seed": seed}, scenario))
     return runs
 
@@ -367,6 +372,8 @@ def render_run(
     for sub in ("images", "masks"):
         shutil.rmtree(out / sub / run.id, ignore_errors=True)  # a partial earlier attempt
         (out / sub / run.id).mkdir(parents=True)
+    for sub in ("truth", "features", "runs"):  # a sweep's run ids nest: <scenario>/<draw>-…
+        (out / sub / run.id).parent.mkdir(parents=True, exist_ok=True)
     pipeline = dataset_pipeline(scenario)
     images, annotations = [], []
     truth_lines, feature_rows = [], []
@@ -515,9 +522,14 @@ def estimate(runs: list[DatasetRun], finished: list[dict[str, Any]]) -> SizeEsti
     if measured:
         per = sum(r["bytes"] for r in measured) / sum(r["frames"] for r in measured)
         return SizeEstimate(len(runs), frames, per, True)
-    cam = runs[0].scenario.robot.camera if runs else CameraSpec()
-    per = cam.width * cam.height * EST_JPEG_BYTES_PER_PIXEL + EST_OTHER_BYTES
+    # From each run's camera: a sweep's families differ in resolution.
+    guess = sum(r.scenario.frames * _frame_bytes(r.scenario.robot.camera) for r in runs)
+    per = guess / frames if frames else _frame_bytes(CameraSpec())
     return SizeEstimate(len(runs), frames, per, False)
+
+
+def _frame_bytes(cam: CameraSpec) -> float:
+    return cam.width * cam.height * EST_JPEG_BYTES_PER_PIXEL + EST_OTHER_BYTES
 
 
 def finished_runs(out: Path, runs: list[DatasetRun]) -> dict[str, dict[str, Any]]:
@@ -555,6 +567,9 @@ def prepare_folder(spec: DatasetSpec, out: Path) -> None:
     for sub in ("images", "masks", "truth", "features", "runs", "annotations"):
         (out / sub).mkdir(parents=True, exist_ok=True)
     write_text_atomically(out / "spec.toml", spec.text)
+    for name, text in spec.scenario_files:
+        (out / "scenarios" / name).parent.mkdir(parents=True, exist_ok=True)
+        write_text_atomically(out / "scenarios" / name, text)
     write_text_atomically(
         out / "dataset.json",
         json.dumps(
@@ -609,7 +624,7 @@ def merge(spec: DatasetSpec, out: Path, records: list[dict[str, Any]]) -> dict[s
         write_text_atomically(out / "annotations" / f"{skeleton}.json", json.dumps(coco))
     frames_csv, case_counts = _frames_csv(out, records)
     write_text_atomically(out / "frames.csv", frames_csv)
-    write_text_atomically(out / "runs.csv", _runs_csv(records))
+    write_text_atomically(out / "runs.csv", _runs_csv(spec, records))
     visibility = Counter(v for a in anns for v in a["keypoints33"][2::3])
     counts = {
         "runs": len(records),
@@ -623,6 +638,9 @@ def merge(spec: DatasetSpec, out: Path, records: list[dict[str, Any]]) -> dict[s
         "keypoints_outside": visibility.get(0, 0),
         "cases": dict(sorted(case_counts.items())),
     }
+    if isinstance(spec.source, SweepSpec):
+        counts["families"] = dict(Counter(r["params"]["family"] for r in records))
+        counts["image_sizes"] = sorted({(i["width"], i["height"]) for i in images})
     counts["bytes"] = sum(r["bytes"] for r in records)
     write_text_atomically(out / "README.md", readme(spec, counts))
     counts["bytes"] = _folder_bytes(out)
@@ -668,16 +686,21 @@ def _frames_csv(out: Path, records: list[dict[str, Any]]) -> tuple[str, Counter]
     return buf.getvalue(), cases
 
 
-def _runs_csv(records: list[dict[str, Any]]) -> str:
+GRID_RUN_COLUMNS = ("case", "distance", "lateral_offset", "pedestrian_speed", "robot_speed",
+                    "angle_deg", "repeat", "seed")  # fmt: skip
+SWEEP_RUN_COLUMNS = ("family", "kind", "scale", "parameters", "seed")  # parameters: JSON
+
+
+def _runs_csv(spec: DatasetSpec, records: list[dict[str, Any]]) -> str:
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    keys = ("case", "distance", "lateral_offset", "pedestrian_speed", "robot_speed", "angle_deg",
-            "repeat", "seed")  # fmt: skip
+    keys = SWEEP_RUN_COLUMNS if isinstance(spec.source, SweepSpec) else GRID_RUN_COLUMNS
     w.writerow(("run", *keys, "frames", "annotated", "pose_found", "contact_time", "bytes"))
     for r in records:
         p = r["params"]
+        cells = (json.dumps(p[k]) if isinstance(p[k], dict) else p[k] for k in keys)
         w.writerow(
-            (r["id"], *(p[k] for k in keys), r["frames"], len(r["annotations"]), r["pose_found"],
+            (r["id"], *cells, r["frames"], len(r["annotations"]), r["pose_found"],
              r["contact_time"], r["bytes"])
         )  # fmt: skip
     return buf.getvalue()
@@ -691,9 +714,13 @@ def readme(spec: DatasetSpec, counts: dict[str, Any]) -> str:
     """The dataset card."""
     import mujoco
 
-    g, cam = spec.grid, spec.camera
+    if isinstance(spec.source, SweepSpec):
+        what, image_format, runs = _sweep_card(spec, spec.source, counts)
+    else:
+        what, image_format, runs = _grid_card(spec.source)
     cases = ", ".join(f"{Case(c).label} ({c}): {n}" for c, n in counts["cases"].items())
-    image_format = f"{cam.width}x{cam.height}, {spec.fps:g} fps, JPEG quality {JPEG_QUALITY}"
+    copied = " (the spec is copied to `spec.toml`"
+    copied += ", the scenario files it includes to `scenarios/`)" if spec.scenario_files else ")"
     keypoints = " / ".join(
         str(counts[k]) for k in ("keypoints_visible", "keypoints_occluded", "keypoints_outside")
     )
@@ -703,9 +730,7 @@ def readme(spec: DatasetSpec, counts: dict[str, Any]) -> str:
 
 ## What
 
-Images from the forward camera of a small robot driving a MuJoCo street while a
-mannequin pedestrian walks one of the paper's nine motion cases, with ground truth
-from the simulator.
+{what}
 
 | | |
 | --- | --- |
@@ -722,20 +747,9 @@ Frames per ground-truth case (the case of the next second of true motion): {case
 
 ## How it was made
 
-`monopic dataset {spec.path.name} --out DIR` (the spec is copied to `spec.toml`), with
+`monopic dataset {spec.path.name} --out DIR`{copied}, with
 monopic's simulator (sim/), MuJoCo {mujoco.__version__} rendering headless (EGL), on
-{platform.machine()} / Python {platform.python_version()}. Each run is one
-`sim.cases.place_case` scenario, for every combination of:
-
-- cases {list(g.cases)};
-- distances {list(g.distances)} m ahead, lateral offsets {list(g.lateral_offsets)} m;
-- walking speeds {list(g.pedestrian_speeds)} m/s, robot speeds {list(g.robot_speeds)} m/s;
-- oblique angles {list(g.angles)} deg; {g.repeats} repeat(s).
-
-{spec.duration:g} s per run (a run stops at contact), horizon {spec.horizon:g} s. Camera:
-{cam.vertical_fov_deg:g} deg vertical field of view, {cam.mount_height:g} m high,
-pitched {cam.pitch_deg:g} deg down. The gait phase of run k comes from seed {spec.seed}
-and k; the pipeline is the paper's image mode (rule cascade) on one onnxruntime thread.
+{platform.machine()} / Python {platform.python_version()}. {runs}
 
 Deterministic: the same spec gives the same images, masks, annotations and truth on the
 same software; the features' measured-time columns (`detectMs` … `totalMs`) differ
@@ -768,3 +782,69 @@ between invocations. Resumable: finished runs (`runs/<run>.json`) are skipped.
 {spec.licence}. Everything in the images is generated by the test bed (procedural
 textures, the mannequin, the street); no third-party data is included.
 """
+
+
+def _grid_card(source: CaseGrid) -> tuple[str, str, str]:
+    """The card's parts for a case grid: what, the image format, how the runs were made."""
+    g, cam = source.grid, source.camera
+    what = """Images from the forward camera of a small robot driving a MuJoCo street while a
+mannequin pedestrian walks one of the paper's nine motion cases, with ground truth
+from the simulator."""
+    image_format = f"{cam.width}x{cam.height}, {source.fps:g} fps, JPEG quality {JPEG_QUALITY}"
+    runs = f"""Each run is one
+`sim.cases.place_case` scenario, for every combination of:
+
+- cases {list(g.cases)};
+- distances {list(g.distances)} m ahead, lateral offsets {list(g.lateral_offsets)} m;
+- walking speeds {list(g.pedestrian_speeds)} m/s, robot speeds {list(g.robot_speeds)} m/s;
+- oblique angles {list(g.angles)} deg; {g.repeats} repeat(s).
+
+{source.duration:g} s per run (a run stops at contact), horizon {source.horizon:g} s. Camera:
+{cam.vertical_fov_deg:g} deg vertical field of view, {cam.mount_height:g} m high,
+pitched {cam.pitch_deg:g} deg down. The gait phase of run k comes from seed {source.seed}
+and k; the pipeline is the paper's image mode (rule cascade) on one onnxruntime thread."""
+    return what, image_format, runs
+
+
+def _sweep_card(
+    spec: DatasetSpec, sweep: SweepSpec, counts: dict[str, Any]
+) -> tuple[str, str, str]:
+    """The card's parts for a sweep spec: what, the image formats, how the runs were made."""
+    what = """Images from the forward camera of a robot (small robot or car, as each scenario
+file says) driving a MuJoCo street while a mannequin pedestrian crosses, walks along
+or stops as the scenario families of a sweep spec (Euro NCAP-style collisions, near
+misses, the paper's motion cases) describe, with ground truth from the simulator."""
+    sizes = ", ".join(f"{w}x{h}" for w, h in counts["image_sizes"]) or "none"
+    image_format = f"{sizes}, JPEG quality {JPEG_QUALITY}"
+    includes = "\n".join(f"- {_include_text(spec.path.parent, i)};" for i in sweep.includes)
+    families = ", ".join(f"{name}: {n}" for name, n in counts["families"].items())
+    runs = f"""The runs are those of the sweep
+spec, exactly as `monopic sweep` expands it (the same scenarios and seeds, and the same
+run ids, `<scenario name>/<draw>-<digest of the scenario>`, so run folders nest). It
+includes:
+
+{includes}
+
+Runs per family: {families}.
+
+Each run lasts as its scenario file says (a run stops at contact), with that file's
+frame rate, horizon, camera, road, lighting and pedestrian; the pipeline is the paper's
+image mode (rule cascade) on one onnxruntime thread."""
+    return what, image_format, runs
+
+
+def _include_text(folder: Path, include: Include) -> str:
+    """One [[include]] entry as the card lists it."""
+    files = ", ".join(f"`{os.path.relpath(f, folder)}`" for f in include.files)
+    how = [f"sampling {include.sampling}"]
+    if include.runs is not None:
+        how.append(f"{include.runs} run{'s' if include.runs != 1 else ''} per file")
+    if include.seed is not None:
+        how.append(f"seed {include.seed}")
+    for key, dist in include.parameters.items():
+        if isinstance(dist, Values):
+            how.append(f"{key} in {list(dist.values)}")
+        else:
+            steps = f" in {dist.steps} steps" if dist.steps else ""
+            how.append(f"{key} from {dist.low:g} to {dist.high:g}{steps}")
+    return f"{files}: {', '.join(how)}"

@@ -12,7 +12,6 @@ from __future__ import annotations
 
 import copy
 import math
-import tomllib
 import zlib
 from collections.abc import Iterator, Mapping
 from dataclasses import dataclass, field, replace
@@ -22,7 +21,6 @@ from typing import Any
 import numpy as np
 
 from monopic.cases import Case
-from monopic.errors import UserError
 from sim.cases import place_case
 from sim.families import (
     BODIES,
@@ -45,143 +43,15 @@ from sim.families import (
 from sim.pedestrian import PedestrianPath
 from sim.road import Occluder, RoadLayout
 from sim.scenario import CameraSpec, Leg, PedestrianSpec, RobotSpec, Scenario, SceneSpec
+from sim.toml_table import MISSING, FieldError, TomlTable, read_toml, show
 
 KINDS = ("case", "collision", "near-miss")
 PATH_KINDS = ("case", "crossing", "longitudinal", "explicit")
 SAMPLING = ("grid", "random")
 MAX_GRID_RUNS = 100_000
-_MISSING: Any = object()
 
 
-class ScenarioFileError(UserError):
-    """One bad value in a scenario file: which file, which field, what value, why."""
-
-    def __init__(self, file: Path | str, field: str, value: object, reason: str) -> None:
-        self.file, self.field, self.value, self.reason = str(file), field, value, reason
-        shown = f" = {_show(value)}" if value is not _MISSING else ""
-        super().__init__(f"{file}: {field}{shown}: {reason}")
-
-
-def _show(value: object) -> str:
-    """A value as the file would spell it (tables inline)."""
-    if isinstance(value, dict):
-        return "{" + ", ".join(f"{k} = {_show(v)}" for k, v in value.items()) + "}"
-    return repr(value)
-
-
-def _type_name(value: object) -> str:
-    return {bool: "a boolean", int: "an integer", float: "a number", str: "a string"}.get(
-        type(value), "a table" if isinstance(value, dict) else "a list"
-    )
-
-
-class Table:
-    """One TOML table being read: typed getters naming the dotted field; leftovers are unknown."""
-
-    def __init__(self, file: Path, prefix: str, data: Mapping[str, Any]) -> None:
-        self.file, self.prefix, self.data = file, prefix, dict(data)
-        self.seen: set[str] = set()
-
-    def name(self, key: str) -> str:
-        return f"{self.prefix}.{key}" if self.prefix else key
-
-    def error(self, key: str, value: object, reason: str) -> ScenarioFileError:
-        return ScenarioFileError(self.file, self.name(key), value, reason)
-
-    def has(self, key: str) -> bool:
-        return key in self.data
-
-    def raw(self, key: str, default: Any = _MISSING) -> Any:
-        self.seen.add(key)
-        if key not in self.data:
-            if default is _MISSING:
-                raise ScenarioFileError(self.file, self.name(key), _MISSING, "missing (required)")
-            return default
-        return self.data[key]
-
-    def number(
-        self,
-        key: str,
-        default: Any = _MISSING,
-        *,
-        low: float | None = None,
-        high: float | None = None,
-        positive: bool = False,
-        unit: str = "",
-    ) -> float:
-        """A finite float (integers accepted) in [low, high]; `positive` excludes zero."""
-        value = self.raw(key, default)
-        if value is None:
-            return value
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise self.error(key, value, f"must be a number{_unit(unit)}, not {_type_name(value)}")
-        value = float(value)
-        if not math.isfinite(value):
-            raise self.error(key, value, "must be a finite number")
-        if positive and not value > 0:
-            raise self.error(key, value, f"must be > 0{_unit(unit)}")
-        if low is not None and value < low:
-            raise self.error(key, value, f"must be >= {low:g}{_unit(unit)}")
-        if high is not None and value > high:
-            raise self.error(key, value, f"must be <= {high:g}{_unit(unit)}")
-        return value
-
-    def integer(self, key: str, default: Any = _MISSING, *, low: int = 0, high: int | None = None):
-        value = self.raw(key, default)
-        if isinstance(value, bool) or not isinstance(value, int):
-            raise self.error(key, value, f"must be an integer, not {_type_name(value)}")
-        if value < low or (high is not None and value > high):
-            span = f"in [{low}, {high}]" if high is not None else f">= {low}"
-            raise self.error(key, value, f"must be an integer {span}")
-        return value
-
-    def text(self, key: str, default: Any = _MISSING, choices: tuple[str, ...] = ()) -> str:
-        value = self.raw(key, default)
-        if not isinstance(value, str):
-            raise self.error(key, value, f"must be a string, not {_type_name(value)}")
-        if choices and value not in choices:
-            raise self.error(key, value, f"must be one of {', '.join(choices)}")
-        return value
-
-    def flag(self, key: str, default: Any = _MISSING) -> bool:
-        value = self.raw(key, default)
-        if not isinstance(value, bool):
-            raise self.error(key, value, f"must be true or false, not {_type_name(value)}")
-        return value
-
-    def table(self, key: str) -> Table:
-        value = self.raw(key, {})
-        if not isinstance(value, dict):
-            raise self.error(key, value, f"must be a table, not {_type_name(value)}")
-        return Table(self.file, self.name(key), value)
-
-    def tables(self, key: str) -> list[Table]:
-        value = self.raw(key, [])
-        if not isinstance(value, list) or not all(isinstance(v, dict) for v in value):
-            raise self.error(key, value, "must be a list of tables ([[...]] or [{...}, ...])")
-        return [Table(self.file, f"{self.name(key)}[{k}]", v) for k, v in enumerate(value)]
-
-    def numbers(self, key: str, default: Any = _MISSING) -> list[float]:
-        value = self.raw(key, default)
-        if not isinstance(value, list):
-            raise self.error(key, value, f"must be a list of numbers, not {_type_name(value)}")
-        out = []
-        for v in value:
-            if isinstance(v, bool) or not isinstance(v, int | float) or not math.isfinite(v):
-                raise self.error(key, value, "must be a list of finite numbers")
-            out.append(float(v))
-        return out
-
-    def done(self) -> None:
-        """Reject keys nobody asked for (typos, keys of another path kind)."""
-        for key in self.data:
-            if key not in self.seen:
-                known = ", ".join(sorted(self.seen)) or "none"
-                raise self.error(key, self.data[key], f"unknown key (known here: {known})")
-
-
-def _unit(unit: str) -> str:
-    return f" {unit}" if unit else ""
+ScenarioFileError = FieldError  # the name callers of this module know
 
 
 # -- sweeps ---------------------------------------------------------------------------
@@ -233,8 +103,8 @@ class Sweep:
     seed: int = 0
 
 
-def parse_distribution(table: Table, key: str) -> Distribution:
-    """A parameter distribution: a list of values or {min, max, steps?}."""
+def parse_distribution(table: TomlTable, key: str, need_steps: bool = False) -> Distribution:
+    """A parameter distribution: a list of values or {min, max, steps?} (steps: in a grid)."""
     value = table.raw(key)
     if isinstance(value, list):
         if not value:
@@ -248,33 +118,31 @@ def parse_distribution(table: Table, key: str) -> Distribution:
             raise table.error(key, value, "values must be numbers, strings or booleans of one type")
         return Values(tuple(value))
     if isinstance(value, dict):
-        inner = Table(table.file, table.name(key), value)
+        inner = table.table(key)
         low, high = inner.number("min"), inner.number("max")
-        steps = inner.integer("steps", None, low=1) if inner.has("steps") else None
+        steps = inner.integer("steps", None, low=1)
         inner.done()
         if high < low:
             raise table.error(key, value, "max must be >= min")
+        if need_steps and steps is None:
+            raise table.error(key, value, "a range needs steps in a grid")
         return Range(low, high, steps)
     raise table.error(key, value, "must be a list of values or a table {min, max, steps}")
 
 
-def parse_sweep(table: Table) -> Sweep:
+def parse_parameters(table: TomlTable, need_steps: bool = False) -> dict[str, Distribution]:
+    """The `parameters` sub-table: dotted keys of a scenario file, each a distribution."""
+    params = table.table("parameters")
+    return {key: parse_distribution(params, key, need_steps) for key in params.free_keys()}
+
+
+def parse_sweep(table: TomlTable) -> Sweep:
     sampling = table.text("sampling", "grid", SAMPLING)
     runs = table.integer("runs", 1, low=1)
     seed = table.integer("seed", 0)
-    params_table = table.table("parameters")
-    parameters = {key: parse_distribution(params_table, key) for key in params_table.data}
-    params_table.seen.update(params_table.data)
+    parameters = parse_parameters(table, need_steps=sampling == "grid")
     table.done()
-    if sampling == "grid":
-        for key, dist in parameters.items():
-            if isinstance(dist, Range) and dist.steps is None:
-                raise params_table.error(key, _range_dict(dist), "a range needs steps in a grid")
     return Sweep(sampling, parameters, runs, seed)
-
-
-def _range_dict(r: Range) -> dict[str, float]:
-    return {"min": r.low, "max": r.high}
 
 
 def expand(sweep: Sweep | None, family: str) -> Iterator[dict[str, Any]]:
@@ -339,7 +207,7 @@ class ScenarioFile:
         except ScenarioFileError as err:
             if not params:
                 raise
-            shown = ", ".join(f"{k} = {_show(v)}" for k, v in params.items())
+            shown = ", ".join(f"{k} = {show(v)}" for k, v in params.items())
             raise ScenarioFileError(
                 err.file, err.field, err.value, f"{err.reason} (with sweep values {shown})"
             ) from None
@@ -366,30 +234,19 @@ def with_values(data: Mapping[str, Any], params: Mapping[str, Any]) -> dict[str,
 def load(path: Path | str) -> ScenarioFile:
     """Read and validate one scenario file (its base scenario and every sweep value)."""
     path = Path(path)
-    try:
-        with path.open("rb") as fh:
-            data = tomllib.load(fh)
-    except FileNotFoundError:
-        raise UserError(f"{path}: no such scenario file") from None
-    except IsADirectoryError:
-        raise UserError(f"{path}: is a folder, not a scenario file") from None
-    except tomllib.TOMLDecodeError as err:
-        raise UserError(f"{path}: not valid TOML: {err}") from None
-    sweep_data = data.pop("sweep", None)
-    top = Table(path, "", data)
-    name = top.text("name")
-    if not name or any(c.isspace() or c in "/\\" for c in name):
-        raise top.error("name", name, "must be a non-empty name without spaces or slashes")
+    _, data = read_toml(path, "scenario file")
+    top = TomlTable(path, "", data)
+    sweep_table = top.table("sweep") if top.has("sweep") else None
+    data.pop("sweep", None)  # the base scenario is the file without its sweep
+    name = top.slug("name")
     family = top.text("family", name)
     kind = top.text("kind", "case", KINDS)
     scale = Scale(top.text("scale", "small", tuple(s.value for s in Scale)))
     description = top.text("description", "")
     base = build(path, data)
     sweep = None
-    if sweep_data is not None:
-        if not isinstance(sweep_data, dict):
-            raise ScenarioFileError(path, "sweep", sweep_data, "must be a table")
-        sweep = parse_sweep(Table(path, "sweep", sweep_data))
+    if sweep_table is not None:
+        sweep = parse_sweep(sweep_table)
         _check_parameters(path, data, sweep)
     return ScenarioFile(path, name, family, kind, scale, description, data, sweep, base)
 
@@ -398,7 +255,7 @@ def _check_parameters(path: Path, data: dict[str, Any], sweep: Sweep) -> None:
     """Every value of every parameter must build on its own (type, range, known key)."""
     for key, dist in sweep.parameters.items():
         if key.split(".")[0] in ("sweep", "name", "family", "kind", "scale"):
-            raise ScenarioFileError(path, f"sweep.parameters.{key}", _MISSING, "cannot be swept")
+            raise ScenarioFileError(path, f"sweep.parameters.{key}", MISSING, "cannot be swept")
         values = dist.grid() if isinstance(dist, Values) or dist.steps else (dist.low, dist.high)
         for value in values:
             try:
@@ -418,7 +275,7 @@ def _check_parameters(path: Path, data: dict[str, Any], sweep: Sweep) -> None:
 
 def build(path: Path, data: Mapping[str, Any]) -> Scenario:
     """Validate a file's data (without its sweep) and build the Scenario it describes."""
-    top = Table(path, "", data)
+    top = TomlTable(path, "", data)
     name = top.text("name")
     family = top.text("family", name)
     top.text("kind", "case", KINDS)
@@ -462,7 +319,7 @@ def build(path: Path, data: Mapping[str, Any]) -> Scenario:
     return scenario
 
 
-def _robot(t: Table, preset: RobotSpec) -> RobotSpec:
+def _robot(t: TomlTable, preset: RobotSpec) -> RobotSpec:
     max_speed = t.number("max_speed", preset.max_speed, positive=True, high=40.0, unit="m/s")
     robot = RobotSpec(
         speed=t.number("speed", preset.speed, low=0.0, high=max_speed, unit="m/s"),
@@ -481,7 +338,7 @@ def _robot(t: Table, preset: RobotSpec) -> RobotSpec:
     return robot
 
 
-def _camera(t: Table, preset: CameraSpec) -> CameraSpec:
+def _camera(t: TomlTable, preset: CameraSpec) -> CameraSpec:
     camera = CameraSpec(
         width=t.integer("width", preset.width, low=64, high=4096),
         height=t.integer("height", preset.height, low=64, high=4096),
@@ -496,7 +353,7 @@ def _camera(t: Table, preset: CameraSpec) -> CameraSpec:
     return camera
 
 
-def _scene(t: Table, preset: RoadLayout) -> tuple[RoadLayout, tuple[float, float]]:
+def _scene(t: TomlTable, preset: RoadLayout) -> tuple[RoadLayout, tuple[float, float]]:
     lighting = t.text("lighting", "noon", tuple(LIGHTING))
     azimuth, elevation = LIGHTING[lighting]
     azimuth = t.number("sun_azimuth_deg", azimuth, low=-360.0, high=360.0, unit="degrees")
@@ -522,7 +379,7 @@ def _scene(t: Table, preset: RoadLayout) -> tuple[RoadLayout, tuple[float, float
 
 
 def _path(
-    t: Table,
+    t: TomlTable,
     robot: RobotSpec,
     road: RoadLayout,
     speed: float,
@@ -590,7 +447,7 @@ def _path(
 
 
 def _case_path(
-    t: Table, robot: RobotSpec, speed: float, looks: Any, footprint: float, duration: float
+    t: TomlTable, robot: RobotSpec, speed: float, looks: Any, footprint: float, duration: float
 ) -> tuple[PedestrianSpec, Case]:
     """sim.cases.place_case semantics: the path passes (distance, offset) at meet_time."""
     number = t.integer("case", low=1, high=9)
@@ -620,7 +477,7 @@ def _case_path(
 
 
 def _parked_cars(
-    t: Table, x_line: float | None, robot: RobotSpec, road: RoadLayout
+    t: TomlTable, x_line: float | None, robot: RobotSpec, road: RoadLayout
 ) -> tuple[Occluder, ...]:
     if not t.data:
         return ()
@@ -632,9 +489,7 @@ def _parked_cars(
             raise t.error("placement", placement, "needs path.kind = 'crossing'")
         cars: tuple[Occluder, ...] = parked_cars_around(x_line, y, gap)
     else:
-        xs = t.numbers("x")
-        if not xs:
-            raise t.error("x", xs, "needs at least one position")
+        xs = t.numbers("x", nonempty=True, unit="m")
         cars = tuple(Occluder.parked_car(x, y) for x in xs)
     t.done()
     clearance = abs(y) - max(c.width for c in cars) / 2 - robot.width / 2

@@ -4,6 +4,7 @@ A sweep spec (scenarios/sweeps/*.toml, documented in scenarios/README.md):
 
     name = "demo"
     ablation = true                 # also run the ground-truth-crop pipeline
+    licence = "CC-BY-4.0"           # only for `monopic dataset` (a sweep ignores it)
     [[include]]
     files = ["../families/car/*.toml"]   # globs, relative to the spec
     sampling = "random"             # "file" (as each file says), "base", "grid", "random"
@@ -24,7 +25,7 @@ import json
 import sys
 import time
 import zlib
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -38,13 +39,14 @@ from sim.scenario_file import (
     ScenarioFile,
     ScenarioFileError,
     Sweep,
-    Table,
     expand,
     load,
-    parse_distribution,
+    parse_parameters,
 )
+from sim.toml_table import TomlTable, read_toml
 
 INCLUDE_SAMPLING = ("file", "base", "grid", "random")
+SPEC_KEYS = ("name", "description", "ablation", "licence", "include")
 
 
 @dataclass(frozen=True)
@@ -65,26 +67,24 @@ class SweepSpec:
     description: str
     ablation: bool
     includes: tuple[Include, ...]
+    # The licence a dataset of these runs states (`monopic dataset`); a sweep ignores it.
+    licence: str | None = None
 
 
 def load_spec(path: Path | str) -> SweepSpec:
     """Read and check a sweep spec; globs must match scenario files."""
-    import tomllib
-
     path = Path(path)
-    try:
-        with path.open("rb") as fh:
-            data = tomllib.load(fh)
-    except FileNotFoundError:
-        raise UserError(f"{path}: no such sweep spec") from None
-    except IsADirectoryError:
-        raise UserError(f"{path}: is a folder, not a sweep spec") from None
-    except tomllib.TOMLDecodeError as err:
-        raise UserError(f"{path}: not valid TOML: {err}") from None
-    top = Table(path, "", data)
-    name = top.text("name")
+    _, data = read_toml(path, "sweep spec")
+    return parse_spec(path, data)
+
+
+def parse_spec(path: Path, data: Mapping[str, Any], doc: str = "scenarios/README.md") -> SweepSpec:
+    """Check a sweep spec's data (keys SPEC_KEYS); `doc` is where the keys are documented."""
+    top = TomlTable(path, "", data, doc)
+    name = top.slug("name")
     description = top.text("description", "")
     ablation = top.flag("ablation", True)
+    licence = top.text("licence", None, nonempty=True)
     includes = []
     for entry in top.tables("include"):
         patterns = entry.raw("files")
@@ -101,17 +101,15 @@ def load_spec(path: Path | str) -> SweepSpec:
                 raise entry.error("files", pattern, "matches no scenario file")
             files.extend(m for m in matched if m not in files)
         sampling = entry.text("sampling", "file", INCLUDE_SAMPLING)
-        runs = entry.integer("runs", None, low=1) if entry.has("runs") else None
-        seed = entry.integer("seed", None) if entry.has("seed") else None
-        params_table = entry.table("parameters")
-        parameters = {k: parse_distribution(params_table, k) for k in params_table.data}
-        params_table.seen.update(params_table.data)
+        runs = entry.integer("runs", None, low=1)
+        seed = entry.integer("seed", None)
+        parameters = parse_parameters(entry, need_steps=sampling == "grid")
         entry.done()
         includes.append(Include(tuple(files), sampling, runs, seed, parameters))
     top.done()
     if not includes:
         raise ScenarioFileError(path, "include", [], "a sweep needs at least one [[include]]")
-    return SweepSpec(path, name, description, ablation, tuple(includes))
+    return SweepSpec(path, name, description, ablation, tuple(includes), licence)
 
 
 def _glob(base: Path, pattern: str) -> list[Path]:

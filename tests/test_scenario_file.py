@@ -73,7 +73,7 @@ def test_shipped_sweeps_expand_into_valid_runs_with_unique_ids() -> None:
         (("speed = 2.0", 'speed = "fast"'), "robot.speed", "'fast'", "must be a number"),
         (("speed = 2.0", "speed = -1.0"), "robot.speed", "-1.0", ">= 0"),
         (("speed = 1.4", "speed = nan"), "pedestrian.speed", "nan", "finite"),
-        (("duration = 3.0", "duration = 3.0\nhorizon = 0"), "horizon", "0.0", "> 0"),
+        (("duration = 3.0", "duration = 3.0\nhorizon = 0"), "horizon", "0", "> 0"),
         (("duration = 3.0", "duration = 3.0\nbogus = 1"), "bogus", "1", "unknown key"),
         (("case = 5", "case = 12"), "path.case", "12", "integer in [1, 9]"),
         (("case = 5", "case = 5\nimpact_point = 0.5"), "path.impact_point", "0.5", "unknown key"),
