@@ -13,6 +13,7 @@ from enum import StrEnum
 from monopic.features.extractor import FeatureExtractor
 from monopic.frame import Frame
 from monopic.pose.region import Region
+from monopic.pose.search import GroundBand
 from monopic.pose.tracker import PoseResult, PoseTracker, TrackerConfig
 from monopic.predict.base import Features, Mode, Prediction, Predictor
 from monopic.predict.rules import RulePredictor
@@ -127,7 +128,8 @@ class Pipeline:
         """Run every stage on one frame; `region` overrides detection (ablations only)."""
         h, w = frame.image.shape[:2]
         timer = StageTimer()
-        pose = self.tracker.process(frame.image, region)
+        band = GroundBand.from_camera(frame.ego.camera) if frame.ego is not None else None
+        pose = self.tracker.process(frame.image, region, band)
         timer.lap("pose")
         feats = self.features.update(frame.timestamp, pose.pose, h, frame.ego)
         timer.lap("features")

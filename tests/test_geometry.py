@@ -10,8 +10,9 @@ from hypothesis import strategies as st
 from monopic.camera import CameraModel
 from monopic.features.orientation import facing_angle, look_at, quaternion
 from monopic.pose.anchors import ssd_anchor_centres
-from monopic.pose.detector import Detection, Window, letterbox, tile_windows, weighted_nms
+from monopic.pose.detector import Detection, letterbox, weighted_nms
 from monopic.pose.region import Region
+from monopic.pose.search import Window, tile_windows
 from monopic.variants.zone import RobotGeometry, meets_swept_footprint, point_in_polygon
 
 CAM = CameraModel.from_fov(768, 432, 70, 1.1, pitch_deg=8, mount_forward=0.3)

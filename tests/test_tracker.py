@@ -7,7 +7,7 @@ import cv2
 import numpy as np
 import pytest
 
-from monopic.pose.detector import tile_windows
+from monopic.pose.search import tile_windows
 from monopic.pose.tracker import PoseTracker, TrackerConfig
 from monopic.video import VideoSource
 from tests.test_end_to_end import CLIP

@@ -5,18 +5,18 @@ values in [-1, 1]; each of 2254 anchors regresses box centre, width, height and 
 keypoints (0 mid-hip, 1 full-body size/rotation, 2 mid-shoulder, 3 upper-body), scaled
 by 224; scores are sigmoid(clip(logit, -100, 100)); weighted non-max suppression at
 IoU 0.3. Far pedestrians are too small for the whole frame squeezed into 224 px, so the
-detector can also run on overlapping square tiles (`tile_windows`).
+detector can also run on windows of the frame (monopic.pose.search).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
 
 import cv2
 import numpy as np
 
 from monopic.pose.anchors import INPUT_SIZE, ssd_anchor_centres
+from monopic.pose.search import Window
 from monopic.pose.sessions import DETECTOR_FILE, make_session, model_path
 
 MIN_SCORE = 0.5
@@ -30,16 +30,6 @@ class Detection:
     score: float
     box: tuple[float, float, float, float]  # xmin, ymin, xmax, ymax
     keypoints: np.ndarray  # (4, 2): mid-hip, full-body scale, mid-shoulder, upper-body scale
-
-
-@dataclass(frozen=True)
-class Window:
-    """A rectangular part of the frame the detector looks at (may extend past the edges)."""
-
-    x: float
-    y: float
-    width: float
-    height: float
 
 
 class PoseDetector:
@@ -115,20 +105,6 @@ def letterbox(image: np.ndarray, win: Window, size: int):
         return (t - (pad_x, pad_y)) / scale + (win.x, win.y)
 
     return tensor, to_frame
-
-
-def tile_windows(width: int, height: int, tile: int, overlap: float = 0.25) -> list[Window]:
-    """Square tiles of side `tile` covering the frame with at least `overlap` between them."""
-    if tile >= max(width, height):
-        return [Window(0, 0, width, height)]
-
-    def starts(length: int) -> list[float]:
-        if tile >= length:
-            return [(length - tile) / 2]
-        n = math.ceil((length - tile) / (tile * (1 - overlap))) + 1
-        return [i * (length - tile) / (n - 1) for i in range(n)]
-
-    return [Window(x, y, tile, tile) for y in starts(height) for x in starts(width)]
 
 
 def iou(a: tuple[float, float, float, float], b: tuple[float, float, float, float]) -> float:

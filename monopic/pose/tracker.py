@@ -2,10 +2,12 @@
 
 Acquire: run the detector on the whole frame, then on square tiles of decreasing size
 until someone is found (far pedestrians are too small for the whole frame squeezed into
-224 px); keep the most confident detection. The tiles cost one detector pass each (27 at
-768x432, about 380 ms on one core), so a frame spends at most `search_budget` passes:
-the whole frame every time (near pedestrians are found at once) and the next tiles of the
-cascade, which resumes where the previous frame stopped. Track: crop the rotated region, run the
+224 px; monopic.pose.search says which tiles, fewer and smaller ones when the camera's
+ground band is known); keep the most confident detection. Each tile costs a detector
+pass (the 27 tiles of a 768x432 frame took about 380 ms on one core), so a frame spends
+at most `search_budget` passes: the whole frame every time (near pedestrians are found at
+once) and the next tiles of the cascade, which resumes where the previous frame stopped.
+Track: crop the rotated region, run the
 landmark model, take the next frame's region from this frame's auxiliary points. When the
 pose flag drops, the person is lost and the detector runs again (in the same frame).
 """
@@ -17,9 +19,10 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monopic.pose.detector import PoseDetector, Window, tile_windows
+from monopic.pose.detector import PoseDetector
 from monopic.pose.landmarks import LandmarkModel, Pose
 from monopic.pose.region import DEFAULT_SCALE, Region
+from monopic.pose.search import GroundBand, Window, search_windows
 
 
 @dataclass(frozen=True)
@@ -30,10 +33,12 @@ class TrackerConfig:
     region_scale: float = DEFAULT_SCALE
     # Square tile sides tried, in order, after the whole frame finds nobody.
     acquire_tiles: tuple[int, ...] = (432, 288, 216)
+    # Upscaled tiles for far pedestrians, tried only inside the camera's ground band.
+    far_tiles: tuple[int, ...] = (96,)
     tile_overlap: float = 0.25
     # Detector passes per frame while searching: the whole frame + (budget - 1) tiles of
     # the cascade. 0 runs the whole cascade in every frame (offline, no time limit).
-    search_budget: int = 4
+    search_budget: int = 6
 
     def __post_init__(self) -> None:
         if self.search_budget < 0 or self.search_budget == 1 and self.acquire_tiles:
@@ -72,11 +77,14 @@ class PoseTracker:
         self._region = None
         self._next_tile = 0
 
-    def process(self, image: np.ndarray, region: Region | None = None) -> PoseResult:
+    def process(
+        self, image: np.ndarray, region: Region | None = None, band: GroundBand | None = None
+    ) -> PoseResult:
         """Landmarks of the tracked person in this RGB frame.
 
         `region`, when given, replaces detection and tracking for this frame (used to feed
-        a known crop, e.g. for ablations); the next frame tracks from its result.
+        a known crop, e.g. for ablations); the next frame tracks from its result. `band`,
+        from the camera model when known, narrows the search to where people can stand.
         """
         runs, detect_ms, landmark_ms = 0, 0.0, 0.0
         if region is not None:
@@ -84,7 +92,7 @@ class PoseTracker:
         for attempt in range(2):
             if self._region is None:
                 t0 = time.perf_counter()
-                self._region, runs_now = self._acquire(image)
+                self._region, runs_now = self._acquire(image, band)
                 runs += runs_now
                 detect_ms += (time.perf_counter() - t0) * 1e3
                 if self._region is None:
@@ -101,12 +109,10 @@ class PoseTracker:
                 break  # fresh detection already failed the landmark check
         return PoseResult(None, runs, detect_ms, landmark_ms)
 
-    def _acquire(self, image: np.ndarray) -> tuple[Region | None, int]:
+    def _acquire(self, image: np.ndarray, band: GroundBand | None) -> tuple[Region | None, int]:
         h, w = image.shape[:2]
         cfg = self.config
-        levels = [
-            tile_windows(w, h, t, cfg.tile_overlap) for t in cfg.acquire_tiles if t < max(w, h)
-        ]
+        levels = search_windows(w, h, cfg.acquire_tiles, cfg.far_tiles, cfg.tile_overlap, band)
         tiles = [win for level in levels for win in level]
         batches: list[list[Window]] = [[Window(0, 0, w, h)]]
         if cfg.search_budget == 0:
