@@ -7,14 +7,22 @@ world, topdown, truth, ttc, alarm, robot):
 - camera/zone              the robot's zone on the image
 - camera/prediction/point  predicted centre at the horizon; .../path the projected path
 - features/{phi,vx,vy}     time series; latency/{stage} per-stage milliseconds
-- events                   warnings as log events
+- events                   the warning's onset and end, each line starting with its time
 Frames are indexed on the `frame` timeline and on `time` (seconds of the stream).
 The file appears whole or not at all: it is written under a temporary name and renamed
 by `close()`.
 
+Colours say who is speaking: the pipeline's estimates (skeleton, phi, the primary
+predictor's point and path) are pink, each predictor has its own colour
+(`predictor_colour`), the zone is coloured by risk (green, yellow, red), and the simulator
+draws the truth in cyan. The camera view is framed on the image, whatever is drawn
+outside it (the zone's near edge lies below the frame).
+
 Callers that add their own entities (the simulator's sim.recording) log them on the same
-stream, `RunRecording.rec`, after `set_time`, and pass their own blueprint; a frame the
-pipeline did not process can still show its image (`log_image`).
+stream, `RunRecording.rec`, after `set_time`, and `start` it with their own blueprint
+before the first frame; a frame the pipeline did not process can still show its image
+(`log_image`). Without a blueprint of the caller's, the file starts on the first image
+with `blueprint(width, height)`.
 """
 
 from __future__ import annotations
@@ -33,24 +41,82 @@ from monopic.pose.skeleton import CONNECTIONS, LANDMARK_NAMES
 
 JPEG_QUALITY = 80
 LATENCY_STAGES = ("detect", "landmarks", "features", "predict", "warning", "total")
+PIPELINE_COLOUR = (255, 80, 200)  # the pipeline's estimates: skeleton, phi, primary's path
+RISK_COLOURS = {"green": (40, 200, 60), "yellow": (240, 200, 0), "red": (230, 30, 30)}
+FEATURE_COLOURS = {"phi": PIPELINE_COLOUR, "vx": (255, 150, 50), "vy": (170, 130, 255)}
+# One colour per predictor in every view and recording; none is the truth's cyan.
+PREDICTOR_COLOURS = {
+    "rules/image": (255, 80, 200),
+    "rules/ground": (255, 170, 230),
+    "id3-tree/image": (255, 190, 30),
+    "id3-tree/ground": (255, 230, 140),
+    "constant-velocity/image": (150, 110, 255),
+    "constant-velocity/ground": (200, 185, 255),
+}
+OTHER_COLOURS = ((255, 110, 70), (200, 160, 110), (230, 230, 230), (255, 60, 120))
 
 
-def blueprint() -> rrb.Blueprint:
-    """Camera view on the left, time series stacked on the right."""
+def predictor_colour(key: str) -> tuple[int, int, int]:
+    """The fixed colour of a predictor key ("rules/image"); unknown keys get a stable one."""
+    if key in PREDICTOR_COLOURS:
+        return PREDICTOR_COLOURS[key]
+    return OTHER_COLOURS[sum(key.encode()) % len(OTHER_COLOURS)]
+
+
+def image_bounds(width: int, height: int) -> rrb.VisualBounds2D:
+    """A 2D view framed on a width x height image."""
+    return rrb.VisualBounds2D(x_range=[0.0, float(width)], y_range=[0.0, float(height)])
+
+
+def events_view(origin: str = "events", name: str = "warnings") -> rrb.TextLogView:
+    """A text log of `origin`: level and text (which starts with the time, see `log_event`).
+
+    The viewer sizes its time column too narrow to read ("+2..."), so the time is in the
+    text instead.
+    """
+    return rrb.TextLogView(
+        origin=origin,
+        name=name,
+        columns=rrb.TextLogColumns(
+            timeline_columns=[
+                rrb.encodings.TimelineColumn(timeline, visible=False)
+                for timeline in ("time", "frame", "log_time")
+            ],
+            text_log_columns=[
+                rrb.encodings.TextLogColumn("loglevel"),
+                rrb.encodings.TextLogColumn("body"),
+                rrb.encodings.TextLogColumn("entitypath", visible=False),
+            ],
+        ),
+    )
+
+
+def panels() -> list[rrb.BlueprintPart]:
+    """Side panels hidden, the small time panel on the `time` timeline (seconds)."""
+    return [
+        rrb.BlueprintPanel(state="hidden"),
+        rrb.SelectionPanel(state="hidden"),
+        rrb.TimePanel(state="collapsed", timeline="time"),
+    ]
+
+
+def blueprint(width: int | None = None, height: int | None = None) -> rrb.Blueprint:
+    """Camera view (framed on the image when its size is given) left, time series right."""
+    bounds = image_bounds(width, height) if width and height else None
     return rrb.Blueprint(
         rrb.Horizontal(
-            rrb.Spatial2DView(origin="camera", name="camera"),
+            rrb.Spatial2DView(origin="camera", name="camera", visual_bounds=bounds),
             rrb.Vertical(
                 rrb.TimeSeriesView(origin="features/phi", name="phi (deg)"),
                 rrb.TimeSeriesView(
                     origin="features", contents=["features/vx", "features/vy"], name="v (px/s)"
                 ),
                 rrb.TimeSeriesView(origin="latency", name="latency (ms)"),
-                rrb.TextLogView(origin="events", name="warnings"),
+                events_view(),
             ),
             column_shares=[3, 2],
         ),
-        collapse_panels=True,
+        *panels(),
     )
 
 
@@ -75,16 +141,20 @@ class RunRecording:
         *,
         layout: rrb.Blueprint | None = None,
     ):
-        """`layout` replaces the default blueprint (e.g. one with the simulator's views)."""
+        """`layout` replaces the default blueprint (or `start` it later, before the images)."""
         self.path = Path(path)
         self.tmp = temporary_sibling(self.path)
         self.rec = rr.RecordingStream(application_id, recording_id=recording_id)
-        self.rec.save(str(self.tmp), default_blueprint=blueprint() if layout is None else layout)
+        self.started = False
+        self.time = 0.0  # seconds of the frame being logged
+        self._warned = False  # the primary predictor's warning on the last processed frame
+        if layout is not None:
+            self.start(layout)
         self.rec.log(
             "camera/pose",
             rr.AnnotationContext(
                 rr.ClassDescription(
-                    info=rr.AnnotationInfo(id=0, label="person"),
+                    info=rr.AnnotationInfo(id=0, label="person", color=PIPELINE_COLOUR),
                     keypoint_annotations=[
                         rr.AnnotationInfo(id=i, label=name) for i, name in enumerate(LANDMARK_NAMES)
                     ],
@@ -93,8 +163,17 @@ class RunRecording:
             ),
             static=True,
         )
-        for name in ("phi", "vx", "vy"):
-            self.rec.log(f"features/{name}", rr.SeriesLines(names=name), static=True)
+        for name, colour in FEATURE_COLOURS.items():
+            self.rec.log(
+                f"features/{name}", rr.SeriesLines(names=name, colors=[colour]), static=True
+            )
+
+    def start(self, layout: rrb.Blueprint) -> None:
+        """Open the file with this blueprint; what was logged before is kept and written."""
+        if self.started:
+            raise RuntimeError(f"{self.path}: the recording has already started")
+        self.rec.save(str(self.tmp), default_blueprint=layout)
+        self.started = True
 
     def log_frame(self, image: np.ndarray, result: FrameResult) -> None:
         """One processed frame: its image and everything the pipeline found."""
@@ -106,9 +185,16 @@ class RunRecording:
         """Put what is logged next on this frame of both timelines."""
         self.rec.set_time("frame", sequence=frame_index)
         self.rec.set_time("time", duration=timestamp)
+        self.time = timestamp
+
+    def log_event(self, text: str, level: str = rr.TextLogLevel.INFO) -> None:
+        """A line in the events view at the current time: "2.07 s  text"."""
+        self.rec.log("events", rr.TextLog(f"{self.time:.2f} s  {text}", level=level))
 
     def log_image(self, image: np.ndarray, entity: str = "camera/image") -> None:
-        """An RGB image, JPEG-compressed, at the current time."""
+        """An RGB image, JPEG-compressed, at the current time (the first one starts the file)."""
+        if not self.started:
+            self.start(blueprint(image.shape[1], image.shape[0]))
         self.rec.log(entity, encoded_jpeg(image))
 
     def log_result(self, result: FrameResult) -> None:
@@ -129,26 +215,35 @@ class RunRecording:
             rec.log("camera/pose", rr.Clear(recursive=False))
         w, p, f = result.warning, result.prediction, result.features
         if w is not None:
-            colour = {"green": (40, 200, 60), "yellow": (240, 200, 0), "red": (230, 30, 30)}[w.risk]
             zone = np.vstack([w.zone, w.zone[:1]])
-            rec.log("camera/zone", rr.LineStrips2D([zone], colors=[colour]))
-            if w.collision:
-                rec.log(
-                    "events",
-                    rr.TextLog(
-                        f"COLLISION IMMINENT: case {int(p.case)} ({p.case.label})",
-                        level=rr.TextLogLevel.WARN,
-                    ),
+            rec.log("camera/zone", rr.LineStrips2D([zone], colors=[RISK_COLOURS[w.risk]]))
+            if w.collision and not self._warned:
+                self.log_event(
+                    f"COLLISION IMMINENT ({result.primary}): case {int(p.case)} ({p.case.label})",
+                    rr.TextLogLevel.WARN,
                 )
+            elif self._warned and not w.collision:
+                self.log_event(f"warning cleared ({result.primary})")
+            self._warned = w.collision
         else:
             rec.log("camera/zone", rr.Clear(recursive=False))
+            self._warned = False
         if p is not None and f is not None:
+            colour = predictor_colour(result.primary)
             rec.log(
                 "camera/prediction/point",
-                rr.Points2D([p.center], radii=-6.0, labels=[f"case {int(p.case)}"]),
+                rr.Points2D(
+                    [p.center],
+                    radii=-6.0,
+                    colors=[colour],
+                    labels=[f"predicted: case {int(p.case)}"],
+                ),
             )
             if result.path is not None:
-                rec.log("camera/prediction/path", rr.LineStrips2D([result.path.image_path]))
+                rec.log(
+                    "camera/prediction/path",
+                    rr.LineStrips2D([result.path.image_path], colors=[colour], radii=-1.5),
+                )
         else:
             rec.log("camera/prediction", rr.Clear(recursive=True))
         if f is not None:
@@ -161,6 +256,8 @@ class RunRecording:
 
     def close(self) -> None:
         """Flush and move the finished file into place."""
+        if not self.started:
+            self.start(blueprint())
         self.rec.flush()
         self.rec.disconnect()
         os.replace(self.tmp, self.path)

@@ -18,13 +18,21 @@ really going to happen) reads at a glance. Entities added to RunRecording's:
 - topdown/image: highway-env's top-down view (sim.env.TopDownViewer), every few frames;
 - time series: truth/phi next to features/phi; ttc/truth and ttc/<predictor> (ground mode's
   predicted time to contact); alarm/truth (contact within the horizon) and
-  alarm/<predictor> (its warning), 0/1; robot/speed and truth/gap (footprint distance);
+  alarm/<predictor> (its warning), 0/1 scalars for tools and, on the same entities, a
+  state lane each (StateChange: clear / collision course / contact for the truth; clear /
+  near / WARNING / no decision for a predictor) so warnings line up against the truth at a
+  glance; robot/speed and truth/gap (footprint distance), brake/command (closed loop);
 - events: first frame on a collision course, contact, pose found and lost, each
   predictor's warning onset, and whatever the caller adds (`log_event`).
 
 `SimRecording` is the per-frame API a runner calls (the sweep can record every run and
 keep only the ones that went wrong: `close()` keeps the file, `abort()` drops it);
 `record_run` runs one scenario through the pipeline and records it.
+
+Colours: truth cyan, robot green, pedestrian orange, the pipeline pink, each predictor its
+own (monopic.recording.predictor_colour) in the 3D view and the plots alike. The camera
+view is framed on the image; the 3D view opens behind and above the robot's start, looking
+toward where robot and pedestrian meet; plots and lanes span the whole run.
 """
 
 from __future__ import annotations
@@ -43,7 +51,16 @@ import rerun.blueprint as rrb
 from monopic.pipeline import FrameResult, Pipeline
 from monopic.pose.skeleton import CONNECTIONS, LANDMARK_NAMES
 from monopic.predict.base import Mode
-from monopic.recording import RunRecording, encoded_jpeg
+from monopic.recording import (
+    FEATURE_COLOURS,
+    RISK_COLOURS,
+    RunRecording,
+    encoded_jpeg,
+    events_view,
+    image_bounds,
+    panels,
+    predictor_colour,
+)
 from monopic.variants.zone import swept_ground_zone
 from sim.ground_truth import GroundTruth
 from sim.runner import make_pipeline, robot_geometry
@@ -52,9 +69,34 @@ from sim.world import World, WorldStep
 
 TRUTH_COLOUR = (0, 210, 255)
 ROBOT_COLOUR = (50, 200, 0)
+ZONE_COLOUR = (150, 240, 150)  # the robot's swept zone on the ground
 PEDESTRIAN_COLOUR = (255, 140, 0)
 ROAD_COLOUR = (150, 150, 150)
-PREDICTION_COLOURS = ((255, 80, 200), (255, 200, 40), (120, 120, 255), (255, 90, 60))
+BRAKE_COLOUR = (255, 110, 70)
+# State lanes (alarm/*): what a predictor said and what was really coming, colour for colour.
+CLEAR, NEAR, WARNING, UNDECIDED = "clear", "near", "WARNING", "no decision"
+COURSE, CONTACT = "collision course", "contact"
+CLEAR_COLOUR = (45, 95, 60)
+# Plots and lanes show the whole timeline: left to itself, each plot fits its own data (a
+# predicted time to contact that exists for half a second fills the width, out of line with
+# the plots beside it). (LinkAxis.LinkToGlobal would make rerun 0.41 ignore the range.)
+WHOLE_RUN = rrb.TimeAxis(
+    view_range=rrb.TimeRange(
+        start=rrb.TimeRangeBoundary.absolute(seconds=0.0), end=rrb.TimeRangeBoundary.infinite()
+    )
+)
+TOP_LEFT = rrb.PlotLegend(corner=rrb.Corner2D.LeftTop)
+TOP_RIGHT = rrb.PlotLegend(corner=rrb.Corner2D.RightTop)
+PREDICTOR_STATES = rr.StateConfiguration(
+    values=[CLEAR, NEAR, WARNING, UNDECIDED],
+    labels=["clear", "near (yellow)", "WARNING", "no decision"],
+    colors=[CLEAR_COLOUR, RISK_COLOURS["yellow"], RISK_COLOURS["red"], (70, 70, 70)],
+)
+TRUTH_STATES = rr.StateConfiguration(
+    values=[CLEAR, COURSE, CONTACT],
+    labels=["truth: no collision coming", "truth: collision within the horizon", "truth: CONTACT"],
+    colors=[CLEAR_COLOUR, RISK_COLOURS["red"], (140, 0, 0)],
+)
 ROBOT_BODY_HEIGHT = 0.4  # m, only for drawing
 PATH_SAMPLES = 11  # points on the true path over the horizon
 DEFAULT_TOPDOWN_EVERY = 3  # frames between top-down images (5 per second at 15 fps)
@@ -129,50 +171,106 @@ def footprint_gap(truth: GroundTruth, pedestrian_size: float) -> float:
 # -- the layout ----------------------------------------------------------------------
 
 
-def sim_blueprint() -> rrb.Blueprint:
-    """Camera big on the left; 3D world over the top-down view on the right; plots below."""
+def sim_blueprint(
+    width: int | None = None,
+    height: int | None = None,
+    eye: rrb.EyeControls3D | None = None,
+) -> rrb.Blueprint:
+    """Camera big on the left; 3D world over the top-down view on the right; plots below.
+
+    The camera view is framed on the width x height image when given; `eye` places the 3D
+    view's eye (see `world_eye`); every plot and the warning lanes show the whole run.
+    """
+    bounds = image_bounds(width, height) if width and height else None
     return rrb.Blueprint(
         rrb.Vertical(
             rrb.Horizontal(
-                rrb.Spatial2DView(origin="camera", name="robot camera: pipeline and truth"),
+                rrb.Spatial2DView(
+                    origin="camera",
+                    name="robot camera: pipeline (pink, zone by risk) and truth (cyan)",
+                    visual_bounds=bounds,
+                ),
                 rrb.Vertical(
-                    rrb.Spatial3DView(origin="world", name="world (3D): truth and ground mode"),
+                    rrb.Spatial3DView(
+                        origin="world",
+                        name="world: truth cyan, robot green, pedestrian orange",
+                        eye_controls=eye,
+                    ),
                     rrb.Spatial2DView(origin="topdown", name="highway-env top-down"),
                     row_shares=[3, 2],
                 ),
                 column_shares=[3, 2],
             ),
             rrb.Horizontal(
+                rrb.StateTimelineView(
+                    origin="alarm", name="warnings vs truth (bottom lane)", time_view=WHOLE_RUN
+                ),
+                rrb.Vertical(
+                    rrb.TimeSeriesView(
+                        origin="ttc",
+                        name="time to contact (s)",
+                        plot_legend=TOP_RIGHT,
+                        axis_x=WHOLE_RUN,
+                    ),
+                    rrb.TimeSeriesView(
+                        origin="/",
+                        contents=["robot/speed", "truth/gap", "brake/command"],
+                        name="robot speed (m/s), footprint gap (m)",
+                        plot_legend=TOP_RIGHT,
+                        axis_x=WHOLE_RUN,
+                    ),
+                ),
                 rrb.Vertical(
                     rrb.TimeSeriesView(
                         origin="/",
                         contents=["features/phi", "truth/phi"],
                         name="phi (deg): estimated vs true",
+                        axis_x=WHOLE_RUN,
                     ),
                     rrb.TimeSeriesView(
                         origin="features",
                         contents=["features/vx", "features/vy"],
                         name="image velocity (px/s)",
+                        axis_x=WHOLE_RUN,
                     ),
                 ),
                 rrb.Vertical(
-                    rrb.TimeSeriesView(origin="ttc", name="time to contact (s)"),
-                    rrb.TimeSeriesView(origin="alarm", name="warning vs true collision (0/1)"),
-                ),
-                rrb.Vertical(
+                    events_view(name="events"),
                     rrb.TimeSeriesView(
-                        origin="/",
-                        contents=["robot/speed", "truth/gap"],
-                        name="robot speed (m/s), footprint gap (m)",
+                        origin="latency",
+                        name="latency (ms)",
+                        plot_legend=TOP_LEFT,
+                        axis_x=WHOLE_RUN,
                     ),
-                    rrb.TimeSeriesView(origin="latency", name="latency (ms)"),
+                    row_shares=[3, 2],
                 ),
-                rrb.TextLogView(origin="events", name="events"),
-                column_shares=[1, 1, 1, 1],
+                column_shares=[4, 3, 3, 4],
             ),
-            row_shares=[3, 2],
+            row_shares=[5, 4],
         ),
-        collapse_panels=True,
+        *panels(),
+    )
+
+
+def world_eye(start: np.ndarray, yaw: float, meet: np.ndarray) -> rrb.EyeControls3D:
+    """An orbiting eye behind and above the robot's `start` (heading `yaw`) toward `meet`.
+
+    `meet` is where the run's story happens (where robot and pedestrian come closest). The
+    eye looks at a point two thirds of the way there, along the robot's heading and a
+    little from its right (a crossing reads sideways), from high and far enough back to
+    keep the robot in view from its first metre on.
+    """
+    start, meet = np.asarray(start, dtype=float)[:2], np.asarray(meet, dtype=float)[:2]
+    span = max(float(np.linalg.norm(meet - start)), 3.0)
+    forward = np.array([math.cos(yaw), math.sin(yaw)])
+    right = np.array([math.sin(yaw), -math.cos(yaw)])
+    target = start + (meet - start) * 2 / 3
+    eye = target - (0.6 * span + 1.5) * forward + 0.25 * span * right
+    return rrb.EyeControls3D(
+        kind=rrb.Eye3DKind.Orbital,
+        position=[float(eye[0]), float(eye[1]), 0.5 * span + 1.5],
+        look_target=[float(target[0]), float(target[1]), 0.0],
+        eye_up=[0.0, 0.0, 1.0],
     )
 
 
@@ -225,6 +323,7 @@ class RecordSummary:
     bytes: int
     missed: tuple[str, ...] = ()  # predictors that never warned while a collision was coming
     false_alarms: tuple[str, ...] = ()  # predictors that warned in a run without a collision
+    primary: str = ""  # the pipeline's primary predictor (its warning is the robot's)
 
 
 class SimRecording:
@@ -250,9 +349,8 @@ class SimRecording:
         self.world = world
         self.scenario: Scenario = world.scenario
         self.topdown_every = topdown_every
-        self.run = RunRecording(
-            Path(path), application_id, recording_id or self.scenario.name, layout=sim_blueprint()
-        )
+        # The file starts on the first step, when the blueprint can frame the world.
+        self.run = RunRecording(Path(path), application_id, recording_id or self.scenario.name)
         self.rec = self.run.rec
         self._topdown: TopDownCamera | None = None
         self._static_done = False
@@ -262,6 +360,8 @@ class SimRecording:
         self._contact_logged = False
         self._warning: dict[str, bool] = {}
         self._drawn: set[str] = set()  # predictors with a prediction in the world view
+        self._styled: set[str] = set()  # predictors whose series and lane have their style
+        self._lanes: dict[str, str] = {}  # entity -> state last logged on its lane
         self._colliding_now = False
         self.frames = 0
         self.found = 0
@@ -277,8 +377,26 @@ class SimRecording:
 
     # -- static parts ------------------------------------------------------------------
 
-    def _log_static(self) -> None:
+    def _meeting_point(self, step: WorldStep) -> np.ndarray:
+        """World (x, y) of the pedestrian where it comes closest to the robot's planned run."""
+        scenario, r = self.scenario, step.truth.robot
+        start = np.asarray(r.position, dtype=float)[:2]
+        path = self.world.pedestrian.path if self.world.pedestrian else None
+        if path is None:
+            return np.asarray(step.truth.position_world, dtype=float)[:2]
+        ahead = np.array([math.cos(r.yaw), math.sin(r.yaw)])
+        times = np.linspace(0.0, scenario.duration, max(2, int(scenario.duration * 20) + 1))
+        peds = np.array([path.state(float(t)).position for t in times])[:, :2]
+        robots = start + np.outer(times * r.speed, ahead)
+        return peds[int(np.argmin(np.linalg.norm(peds - robots, axis=1)))]
+
+    def _log_static(self, step: WorldStep) -> None:
         rec, scenario = self.rec, self.scenario
+        if not self.run.started:
+            cam = self.world.camera
+            r = step.truth.robot
+            eye = world_eye(r.position, r.yaw, self._meeting_point(step))
+            self.run.start(sim_blueprint(cam.width, cam.height, eye))
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
         skeleton = rr.AnnotationContext(
             rr.ClassDescription(
@@ -298,7 +416,6 @@ class SimRecording:
                 centers=[[0.0, 0.0, ROBOT_BODY_HEIGHT / 2]],
                 half_sizes=[[robot.length / 2, robot.width / 2, ROBOT_BODY_HEIGHT / 2]],
                 colors=[ROBOT_COLOUR],
-                labels=["robot"],
             ),
             static=True,
         )
@@ -315,7 +432,7 @@ class SimRecording:
                 principal_point=[cam.cx, cam.cy],
                 resolution=[cam.width, cam.height],
                 camera_xyz=rr.ViewCoordinates.RDF,
-                image_plane_distance=1.0,
+                image_plane_distance=0.3,  # a small frustum: it must not hide the scene
             ),
             static=True,
         )
@@ -332,15 +449,22 @@ class SimRecording:
                 ),
                 static=True,
             )
+        rec.log(  # next to the truth, the pipeline's phi is an estimate
+            "features/phi",
+            rr.SeriesLines(names="estimated phi", colors=[FEATURE_COLOURS["phi"]]),
+            static=True,
+        )
         for name, colour, label in (
             ("truth/phi", TRUTH_COLOUR, "true phi"),
             ("ttc/truth", TRUTH_COLOUR, "true time to contact"),
             ("alarm/truth", TRUTH_COLOUR, "true: contact within the horizon"),
             ("robot/speed", ROBOT_COLOUR, "robot speed"),
             ("truth/gap", TRUTH_COLOUR, "footprint gap"),
+            ("brake/command", BRAKE_COLOUR, "brake command (m/s^2)"),
         ):
-            width = 4.0 if name == "alarm/truth" else 2.0
+            width = 3.0 if name.endswith("truth") else 2.0
             rec.log(name, rr.SeriesLines(names=label, colors=[colour], widths=width), static=True)
+        rec.log("alarm/truth", TRUTH_STATES, static=True)
         self._static_done = True
 
     def _log_road(self) -> None:
@@ -400,7 +524,7 @@ class SimRecording:
     def log_step(self, step: WorldStep, result: FrameResult | None) -> None:
         """One frame: the camera image, the pipeline's result if any, the truth, the world."""
         if not self._static_done:
-            self._log_static()
+            self._log_static(step)
         rec, truth = self.rec, step.truth
         self.run.set_time(step.index, step.time)
         if step.frame is not None:
@@ -409,7 +533,7 @@ class SimRecording:
         if result is not None:
             self.primary = self.primary or result.primary
             self.run.log_result(result)
-            self._log_decisions(result)
+        self._log_decisions(result)
         self._log_camera_truth(truth)
         self._log_world(step)
         self._log_series(truth)
@@ -423,21 +547,46 @@ class SimRecording:
 
     def log_event(self, text: str, level: str = rr.TextLogLevel.INFO) -> None:
         """A line in the events view at the current frame (e.g. the closed loop's brake)."""
-        self.rec.log("events", rr.TextLog(text, level=level))
+        self.run.log_event(text, level)
 
     def log_series(self, entity: str, value: float) -> None:
         """A scalar at the current frame (e.g. the closed loop's brake command)."""
         if math.isfinite(value):
             self.rec.log(entity, rr.Scalars(value))
 
-    def _log_decisions(self, result: FrameResult) -> None:
-        """Every predictor's warning as 0/1; ground mode's prediction in the robot frame."""
+    def _style(self, predictor: str) -> None:
+        """A predictor's colour and name on its series, and its lane's states, once."""
+        name = entity_name(predictor)
+        if name in self._styled:
+            return
+        colour = predictor_colour(predictor)
         rec = self.rec
-        drawn = set()
-        feats = result.features
-        for k, d in enumerate(result.decisions):
+        rec.log(
+            f"ttc/{name}", rr.SeriesLines(names=predictor, colors=[colour], widths=2.0), static=True
+        )
+        rec.log(f"alarm/{name}", rr.SeriesLines(names=predictor, colors=[colour]), static=True)
+        rec.log(f"alarm/{name}", PREDICTOR_STATES, static=True)
+        self._styled.add(name)
+
+    def _lane(self, entity: str, state: str) -> None:
+        """Move a state lane to `state` (logged only when it changes)."""
+        if self._lanes.get(entity) != state:
+            self.rec.log(entity, rr.StateChange(state=state))
+            self._lanes[entity] = state
+
+    def _log_decisions(self, result: FrameResult | None) -> None:
+        """Every predictor's warning as 0/1 and a lane; ground mode's prediction in 3D."""
+        rec = self.rec
+        drawn, decided = set(), set()
+        feats = result.features if result is not None else None
+        for d in result.decisions if result is not None else ():
+            self._style(d.predictor)
             name = entity_name(d.predictor)
+            decided.add(name)
             rec.log(f"alarm/{name}", rr.Scalars(float(d.warning.collision)))
+            risk = d.warning.risk
+            lane = WARNING if d.warning.collision else NEAR if risk == "yellow" else CLEAR
+            self._lane(f"alarm/{name}", lane)
             if d.warning.time_to_contact is not None:
                 rec.log(f"ttc/{name}", rr.Scalars(d.warning.time_to_contact))
             warned = d.warning.collision
@@ -452,12 +601,13 @@ class SimRecording:
                 f"world/robot/prediction/{name}",
                 rr.LineStrips3D(
                     [[[g0[0], g0[1], 0.03], [ground[0], ground[1], 0.03]]],
-                    colors=[PREDICTION_COLOURS[k % len(PREDICTION_COLOURS)]],
+                    colors=[predictor_colour(d.predictor)],
                     radii=0.03,
-                    labels=[d.predictor],
                 ),
             )
             drawn.add(name)
+        for name in self._styled - decided:  # known predictors that could not decide
+            self._lane(f"alarm/{name}", UNDECIDED)
         for name in self._drawn - drawn:  # no ground prediction this frame
             rec.log(f"world/robot/prediction/{name}", rr.Clear(recursive=False))
         self._drawn = drawn
@@ -523,8 +673,8 @@ class SimRecording:
             "world/robot/zone",
             rr.LineStrips3D(
                 [np.column_stack([closed, np.full(len(closed), 0.02)])],
-                colors=[(240, 60, 60)],
-                radii=0.02,
+                colors=[ZONE_COLOUR],
+                radii=0.03,
             ),
         )
         self._robot_trail.append([float(r.position[0]), float(r.position[1]), 0.02])
@@ -559,7 +709,6 @@ class SimRecording:
                 [np.column_stack([future, np.full(len(future), 0.04)])],
                 colors=[TRUTH_COLOUR],
                 radii=0.04,
-                labels=[f"truth +{truth.horizon:g} s"],
             ),
         )
 
@@ -569,6 +718,9 @@ class SimRecording:
         if truth.time_to_collision is not None:
             rec.log("ttc/truth", rr.Scalars(truth.time_to_collision))
         rec.log("alarm/truth", rr.Scalars(float(truth.collision)))
+        self._lane(
+            "alarm/truth", CONTACT if truth.contact else COURSE if truth.collision else CLEAR
+        )
         rec.log("robot/speed", rr.Scalars(truth.robot.speed))
         rec.log("truth/gap", rr.Scalars(footprint_gap(truth, self.scenario.pedestrian.footprint)))
 
@@ -643,6 +795,7 @@ class SimRecording:
             size,
             self.missed(),
             self.false_alarms(),
+            self.primary,
         )
 
     def close(self) -> RecordSummary:

@@ -65,7 +65,8 @@ def run(args: argparse.Namespace) -> int:
         print(
             f"monopic view: no display ($DISPLAY and $WAYLAND_DISPLAY are unset): run "
             f"`rerun {path}` on a machine with a display, or `rerun --serve-web {path}` here "
-            f"and open the http://<this host>:9090 address it prints in a browser",
+            f"and open the http://<this host>:9090 address it prints in a browser (screenshots "
+            f"without a display: tools/view/screenshot.py {path} --at SECONDS)",
             file=sys.stderr,
         )
         return 1
