@@ -53,8 +53,8 @@ import numpy as np
 
 from monopic.cases import GROUND_DEAD_ZONE_MPS, Case
 from monopic.errors import UserError
-from monopic.framelog import AUTHORS_COLUMNS, frame_row
 from monopic.framelog import FRAME_COLUMNS as FEATURE_COLUMNS
+from monopic.framelog import authors_finite, frame_row
 from monopic.output import atomic_path, write_text_atomically
 from monopic.pipeline import Pipeline
 from monopic.predict.base import Mode
@@ -399,7 +399,7 @@ def render_run(
             found += int(result.pose.found)
             if result.features is not None:
                 row = frame_row(result, 1.0 / scenario.dt, scenario.horizon)
-                if _authors_finite(row):
+                if authors_finite(row):
                     feature_rows.append(row)
             image_id = (run.index + 1) * 10000 + k
             images.append(
@@ -463,17 +463,6 @@ def render_run(
     record["bytes"] = _run_bytes(out, run.id)
     write_text_atomically(out / "runs" / f"{run.id}.json", json.dumps(record, default=_plain))
     return record
-
-
-def _authors_finite(row: list[Any]) -> bool:
-    """Whether the authors' columns are all finite numbers, as their log reader demands.
-
-    Not so on a track's first frame (no velocity yet), which the features file leaves out.
-    """
-    try:
-        return all(math.isfinite(float(v)) for v in row[: len(AUTHORS_COLUMNS)])
-    except ValueError:
-        return False
 
 
 def _clipped_box(u0: float, v0: float, u1: float, v1: float, w: int, h: int) -> list[float] | None:
