@@ -34,11 +34,7 @@ from frameset import FrameSet, build, load  # noqa: E402
 from reference_env import ensure  # noqa: E402
 
 ROOT = HERE.parent
-OURS, FIX, REF = "ours", "ours+fix", "reference"
-# The proposed change, measured as a bench-only variant: the landmark model pruned to the
-# outputs used (+ heatmap) and MediaPipe's heatmap refinement (bench/pipeline_worker.py).
-FIX_KEEP = ("landmarks", "pose_flag", "heatmap")
-FIX_MODEL = ROOT / "recordings" / "bench" / "pose_landmark_full.lm-flag-heatmap.onnx"
+OURS, REF = "ours", "reference"
 SHOULDERS, HIPS = (11, 12), (23, 24)
 FPS = 15.0
 GOAL_RATIO = 0.5  # the issue: ours in at most half the reference's time per frame
@@ -64,30 +60,13 @@ class Collected:
         return [r for r in self.runs if r.side == side and r.threads == threads]
 
     def sides(self) -> list[str]:
-        return [x for x in (OURS, FIX, REF) if any(r.side == x for r in self.runs)]
+        return [x for x in (OURS, REF) if any(r.side == x for r in self.runs)]
 
 
 def worker_command(side: str, ref_python: Path) -> tuple[list[str], dict[str, str]]:
     if side == OURS:
         return [sys.executable, str(HERE / "pipeline_worker.py")], {}
-    if side == FIX:
-        return [
-            sys.executable,
-            str(HERE / "pipeline_worker.py"),
-            "--landmark-model",
-            str(FIX_MODEL),
-            "--refine-heatmap",
-        ], {}
     return [str(ref_python), str(HERE / "reference_worker.py")], {"GLOG_minloglevel": "2"}
-
-
-def build_fix_model(ref_python: Path) -> None:
-    """The pruned landmark model the fix variant loads (needs onnx: the reference venv)."""
-    subprocess.run(
-        [str(ref_python), str(HERE / "prune_landmarks.py"), "--out", str(FIX_MODEL), "--keep",
-         *FIX_KEEP],
-        check=True, capture_output=True,
-    )  # fmt: skip
 
 
 def run_worker(
@@ -283,15 +262,12 @@ def main() -> None:
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--warmup", type=int, default=30)
     ap.add_argument("--no-pin", action="store_true", help="do not confine workers to N cores")
-    ap.add_argument("--no-fix", action="store_true", help="leave out the ours+fix variant")
     ap.add_argument("--no-append", action="store_true")
     args = ap.parse_args()
     npy, npz = build()
     fs = load(npy, npz)
     ref_python = ensure()
-    sides = (OURS, REF) if args.no_fix else (OURS, FIX, REF)
-    if not args.no_fix:
-        build_fix_model(ref_python)
+    sides = (OURS, REF)
     col = Collected()
     start = time.perf_counter()
     loads = []
@@ -324,8 +300,7 @@ def main() -> None:
     seqs = ", ".join(fs.sequences)
     lines = [
         f"{n} frames 768x432 in {len(fs.sequences)} sequences ({seqs}); "
-        f"sides {', '.join(sides)} ({FIX}: landmark model pruned to landmarks, pose flag and "
-        "heatmap + MediaPipe's heatmap refinement, bench-only); "
+        f"sides {', '.join(sides)}; "
         f"{args.rounds} ABBA rounds per thread count, {args.warmup} warm-up frames per run; "
         f"workers pinned to N cores: {not args.no_pin}; "
         f"load average during the runs {min(loads):.1f}-{max(loads):.1f} on "

@@ -17,10 +17,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_VENV = ROOT / ".venv-reference"
-# The wheel the paper's authors used and the one whose models we converted; onnx (the
-# newest release that accepts mediapipe's protobuf < 5) to derive model variants for
-# benchmarks (bench/prune_landmarks.py).
-REQUIREMENTS = ("mediapipe==0.10.14", "onnx==1.17.0")
+# The wheel the paper's authors used and the one whose models we converted.
+REQUIREMENTS = ("mediapipe==0.10.14",)
 STAMP = ".installed-stamp"
 
 

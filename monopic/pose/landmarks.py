@@ -4,7 +4,8 @@ The model sees the region as 256x256 RGB in [0, 1] and returns 39 points x (x, y
 visibility logit, presence logit) in crop pixels: the 33 landmarks, then auxiliary points
 whose first two (33 centre, 34 scale/rotation) give the next frame's region. z is in the
 same scale as x; we return it in image pixels like x. The pose flag says whether a person
-is in the crop at all.
+is in the crop at all. As in MediaPipe's pose graph, x and y are then refined from the
+model's 64x64 heatmap output (`refine_from_heatmap`).
 """
 
 from __future__ import annotations
@@ -19,6 +20,10 @@ from monopic.pose.skeleton import NUM_LANDMARKS
 
 INPUT_SIZE = 256
 NUM_POINTS = 39
+# MediaPipe's pose landmark graph runs RefineLandmarksFromHeatmapCalculator with
+# kernel_size 7 and the default min_confidence_to_refine 0.5.
+HEATMAP_KERNEL = 7
+HEATMAP_MIN_CONFIDENCE = 0.5
 
 
 @dataclass(frozen=True)
@@ -58,19 +63,28 @@ class LandmarkModel:
     def __init__(self, threads: int = 1) -> None:
         self.session = make_session(model_path(LANDMARK_FILE), threads)
         self.input_name = self.session.get_inputs()[0].name
-        names = {}
+        # Outputs are told apart by shape: landmarks (1, 195), pose flag (1, 1), heatmap
+        # (1, 64, 64, 39).
+        names: dict[str, str] = {}
         for out in self.session.get_outputs():
-            size = int(np.prod([d for d in out.shape if isinstance(d, int)]))
-            names[size] = out.name
-        self.points_name, self.flag_name = names[NUM_POINTS * 5], names[1]
+            dims = [d for d in out.shape if isinstance(d, int)]
+            size = int(np.prod(dims))
+            if size == NUM_POINTS * 5:
+                names["points"] = out.name
+            elif size == 1:
+                names["flag"] = out.name
+            elif len(out.shape) == 4 and out.shape[-1] == NUM_POINTS:
+                names["heatmap"] = out.name
+        if missing := {"points", "flag", "heatmap"} - names.keys():
+            raise ValueError(f"{LANDMARK_FILE} lacks the {sorted(missing)} output(s)")
+        self.output_names = [names["points"], names["flag"], names["heatmap"]]
 
     def run(self, image: np.ndarray, region: Region) -> Pose:
         crop = region.crop(image, INPUT_SIZE)
         tensor = crop.astype(np.float32) * (1.0 / 255.0)
-        points, flag = self.session.run(
-            [self.points_name, self.flag_name], {self.input_name: tensor[None]}
-        )
+        points, flag, heatmap = self.session.run(self.output_names, {self.input_name: tensor[None]})
         pts = points.reshape(NUM_POINTS, 5).astype(np.float64)
+        pts[:, :2] = refine_from_heatmap(pts[:, :2], heatmap[0], INPUT_SIZE)
         xy = region.to_image(pts[:, :2], INPUT_SIZE)
         z = pts[:, 2] * (region.side / INPUT_SIZE)
         lm = np.column_stack([xy[:NUM_LANDMARKS], z[:NUM_LANDMARKS]])
@@ -82,6 +96,52 @@ class LandmarkModel:
             region=region,
             aux=xy[NUM_LANDMARKS:],
         )
+
+
+def refine_from_heatmap(points: np.ndarray, heatmap: np.ndarray, size: int) -> np.ndarray:
+    """MediaPipe's heatmap refinement of crop-pixel (x, y), vectorised.
+
+    The reference pipeline (MediaPipe Pose) refines the regressed coordinates this way,
+    and on the shipped clip it brings our shoulders closer to the truth (median 3.9 ->
+    2.8 px, BENCHMARKS.md, issue 7). As MediaPipe's
+    mediapipe/calculators/util/refine_landmarks_from_heatmap_calculator.cc: a point
+    whose heatmap cell (x / size * width truncated toward zero, as C++ int()) lies on
+    the map is replaced by the sigmoid-weighted mean cell position over the 7x7 window
+    around that cell (cut at the border), if the window's peak confidence reaches 0.5;
+    otherwise, or off the map, it is left as is. Like the calculator, the result is
+    the weighted cell index / width * size, without a half-cell offset.
+
+    points: (N, 2) x, y in pixels of the size x size crop; heatmap: (H, W, C) logits,
+    channel i for point i (the first min(N, C) points are refined). Returns a copy.
+    """
+    hh, hw, channels = heatmap.shape
+    k = min(channels, len(points))
+    off = (HEATMAP_KERNEL - 1) // 2
+    col = np.trunc(points[:k, 0] / size * hw).astype(int)
+    row = np.trunc(points[:k, 1] / size * hh).astype(int)
+    inside = (col >= 0) & (col < hw) & (row >= 0) & (row < hh)
+    # One gather of the k windows; cells off the map get confidence 0 (the calculator
+    # cuts its window there instead, which sums the same).
+    span = np.arange(-off, off + 1)
+    rows = np.clip(row, 0, hh - 1)[:, None] + span  # (k, 7) heatmap row indices
+    cols = np.clip(col, 0, hw - 1)[:, None] + span
+    on_map = ((rows >= 0) & (rows < hh))[:, :, None] & ((cols >= 0) & (cols < hw))[:, None, :]
+    logits = heatmap[
+        np.clip(rows, 0, hh - 1)[:, :, None],
+        np.clip(cols, 0, hw - 1)[:, None, :],
+        np.arange(k)[:, None, None],
+    ].astype(np.float64)
+    with np.errstate(over="ignore"):  # exp(huge) -> inf -> confidence 0
+        conf = np.where(on_map, 1.0 / (1.0 + np.exp(-logits)), 0.0)  # (k, 7, 7)
+    total = conf.sum(axis=(1, 2))
+    ok = inside & (conf.max(axis=(1, 2)) >= HEATMAP_MIN_CONFIDENCE) & (total > 0)
+    safe = np.where(total > 0, total, 1.0)
+    x = (conf.sum(axis=1) * cols).sum(axis=1) / safe / hw * size
+    y = (conf.sum(axis=2) * rows).sum(axis=1) / safe / hh * size
+    out = np.array(points, dtype=np.float64)
+    out[:k, 0] = np.where(ok, x, out[:k, 0])
+    out[:k, 1] = np.where(ok, y, out[:k, 1])
+    return out
 
 
 def _sigmoid(x: np.ndarray) -> np.ndarray:

@@ -7,11 +7,13 @@ Run through ``make models`` (which provides the pinned conversion venv). Steps:
    every source file is checked against a recorded sha256.
 2. Densify the pose detector (tf2onnx cannot convert its DENSIFY ops).
 3. Convert both models with tf2onnx at a pinned opset, then give inputs/outputs
-   descriptive names, store the (exactly fp16) weights as fp16, and derive node
-   names/order from the graph and fix all strings, so that two runs produce
-   byte-identical files.
+   descriptive names, prune the landmark model to the outputs monopic reads (landmarks,
+   pose flag, heatmap; onnxruntime would otherwise run the segmentation and world
+   landmark branches on every frame), store the (exactly fp16) weights as fp16, and
+   derive node names/order from the graph and fix all strings, so that two runs
+   produce byte-identical files.
 4. Run the ORIGINAL TFLite models (sparse detector included) on a few fixed inputs
-   and write the outputs to ``tests/data/pose_reference.npz``.
+   and write the shipped outputs to ``tests/data/pose_reference.npz``.
 5. Compare ONNX (onnxruntime, 1 thread) against those references and write
    ``NOTICE.md`` / ``LICENSE`` next to the models.
 """
@@ -38,7 +40,13 @@ import tf2onnx  # noqa: E402
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from densify import densify  # noqa: E402
-from onnx_post import canonicalize, rename_values, stamp, store_fp16_weights  # noqa: E402
+from onnx_post import (  # noqa: E402
+    canonicalize,
+    keep_outputs,
+    rename_values,
+    stamp,
+    store_fp16_weights,
+)
 
 REPO = Path(__file__).resolve().parents[2]
 MODELS_DIR = REPO / "monopic" / "pose" / "models"
@@ -62,7 +70,8 @@ MATPLOTLIB_WHEEL_SHA256 = "5439f4c5a3e2e8eab18e2f8c3ef929772fd5641876db71f08127e
 PHOTO = "matplotlib/mpl-data/sample_data/grace_hopper.jpg"
 PHOTO_SHA256 = "a8ca6d734765703b09728ab47fe59f473d93ae3967fc24c7c0288c3c7adb7130"
 SYNTHETIC_SEED = 20240508
-# Coarse sanity gate for a conversion (measured worst: 4e-3, segmentation logits);
+# Coarse sanity gate for a conversion (measured worst of the shipped outputs: 2e-4, landmarks;
+# 4e-3 for the segmentation logits, which are no longer shipped);
 # tests/test_model_fidelity.py holds the real per-output tolerances.
 MAX_REL_DIFF = 0.02
 
@@ -76,6 +85,11 @@ class ModelSpec:
     sha256: str
     size: int
     outputs: tuple[str, ...]  # ONNX names, in the TFLite model's output order
+    keep: tuple[str, ...] | None = None  # the outputs the shipped file has (None: all)
+
+    @property
+    def shipped(self) -> tuple[str, ...]:
+        return self.outputs if self.keep is None else self.keep
 
     @property
     def onnx_path(self) -> Path:
@@ -95,6 +109,8 @@ LANDMARK = ModelSpec(
     sha256="e9a5c5cb17f736fafd4c2ec1da3b3d331d6edbe8a0d32395855aeb2cdfd64b9f",
     size=256,
     outputs=("landmarks", "pose_flag", "segmentation", "heatmap", "world_landmarks"),
+    # monopic reads landmarks + pose flag, and the heatmap for MediaPipe's refinement step.
+    keep=("landmarks", "pose_flag", "heatmap"),
 )
 INPUT_NAME = "image"
 
@@ -146,12 +162,27 @@ def run_tflite(path: Path, image: np.ndarray) -> list[np.ndarray]:
     return [np.array(interp.get_tensor(d["index"])[0]) for d in interp.get_output_details()]
 
 
-def to_onnx(spec: ModelSpec, tflite: Path, source: Path) -> onnx.ModelProto:
+def count_ops(model: onnx.ModelProto, op_type: str) -> int:
+    return sum(node.op_type == op_type for node in model.graph.node)
+
+
+def to_onnx(spec: ModelSpec, tflite: Path, source: Path) -> tuple[onnx.ModelProto, str | None]:
+    """The shipped ONNX model, and a sentence on what pruning removed (None: not pruned)."""
     model, _ = tf2onnx.convert.from_tflite(str(tflite), opset=OPSET)
     graph_outputs = [o.name for o in model.graph.output]
     names = dict(zip(graph_outputs, spec.outputs, strict=True))
     names[model.graph.input[0].name] = INPUT_NAME
     rename_values(model, names)
+    pruned = None
+    if spec.keep is not None:
+        nodes, convs = len(model.graph.node), count_ops(model, "Conv")
+        removed = keep_outputs(model, spec.keep)
+        dropped = ", ".join(f"`{o}`" for o in spec.outputs if o not in spec.keep)
+        pruned = (
+            f"drops {dropped} and the {removed} of {nodes} nodes only they need "
+            f"({convs - count_ops(model, 'Conv')} of {convs} convolutions)"
+        )
+        print(f"{spec.name}: pruned to {', '.join(spec.keep)}: {pruned}")
     print(f"{spec.name}: {store_fp16_weights(model)} weight tensors stored as fp16")
     canonicalize(model)
     stamp(
@@ -165,7 +196,7 @@ def to_onnx(spec: ModelSpec, tflite: Path, source: Path) -> onnx.ModelProto:
         },
     )
     onnx.checker.check_model(model)
-    return model
+    return model, pruned
 
 
 # --- fixed inputs for the fidelity fixture -------------------------------------------------
@@ -228,13 +259,14 @@ FIXTURE_DOC = (
     "'<model>.input' is uint8 NHWC RGB; feed pose_detection as u8/127.5-1 and "
     "pose_landmark_full as u8/255 (float32, batch of 1 per image). "
     "'<model>.<output>' holds the ORIGINAL TFLite model's outputs (TF TFLite interpreter, "
-    "builtin kernels, batch dim stacked over the inputs). Where '<model>.<output>.stride' "
+    "builtin kernels, batch dim stacked over the inputs) for the outputs the shipped ONNX "
+    "file keeps. Where '<model>.<output>.stride' "
     "exists, the stored map is output[:, ::stride, ::stride] (keeps the file small). "
     "Image 0 is Grace Hopper (public domain, from the matplotlib wheel), image 1 a seeded "
     "synthetic image."
 )
 # Spatial subsampling of the big per-pixel outputs in the fixture (NHWC, H and W axes).
-FIXTURE_STRIDES = {"segmentation": 4, "heatmap": 2}
+FIXTURE_STRIDES = {"heatmap": 2}
 
 
 def build_fixture(sources: dict[str, Path], photo_jpeg: bytes) -> dict[str, np.ndarray]:
@@ -243,6 +275,8 @@ def build_fixture(sources: dict[str, Path], photo_jpeg: bytes) -> dict[str, np.n
         outs = [run_tflite(sources[spec.name], x) for x in to_float(spec, images)]
         arrays[f"{spec.name}.input"] = images
         for i, out_name in enumerate(spec.outputs):
+            if out_name not in spec.shipped:
+                continue
             value = np.stack([o[i] for o in outs]).astype(np.float32)
             key = f"{spec.name}.{out_name}"
             if stride := FIXTURE_STRIDES.get(out_name):
@@ -270,10 +304,13 @@ def onnx_max_diffs(
     opts.intra_op_num_threads = 1
     opts.inter_op_num_threads = 1
     sess = ort.InferenceSession(str(spec.onnx_path), opts, providers=["CPUExecutionProvider"])
-    diffs = dict.fromkeys(spec.outputs, (0.0, 0.0))
+    shipped = [o.name for o in sess.get_outputs()]
+    if shipped != list(spec.shipped):
+        raise SystemExit(f"{spec.onnx_path.name} has outputs {shipped}, not {spec.shipped}")
+    diffs = dict.fromkeys(spec.shipped, (0.0, 0.0))
     for k, x in enumerate(to_float(spec, fixture[f"{spec.name}.input"])):
-        outs = sess.run(list(spec.outputs), {INPUT_NAME: x[None]})
-        for name, got in zip(spec.outputs, outs, strict=True):
+        outs = sess.run(shipped, {INPUT_NAME: x[None]})
+        for name, got in zip(shipped, outs, strict=True):
             key = f"{spec.name}.{name}"
             ref = fixture[key][k]
             if f"{key}.stride" in fixture:
@@ -293,7 +330,7 @@ def apache_license(text: str) -> str:
     return text.split("\n====")[0].rstrip() + "\n"
 
 
-def write_notice(diffs: dict[str, dict[str, tuple[float, float]]]) -> None:
+def write_notice(diffs: dict[str, dict[str, tuple[float, float]]], pruned: str) -> None:
     """Provenance, conventions and the measured fidelity, next to the shipped files."""
     rows = []
     for spec in (DETECTOR, LANDMARK):
@@ -318,6 +355,8 @@ def write_notice(diffs: dict[str, dict[str, tuple[float, float]]]) -> None:
         ort=ort.__version__,
         diffs="\n".join(diff_lines),
         matplotlib=MATPLOTLIB,
+        pruned=pruned,
+        keep=", ".join(f"`{o}`" for o in LANDMARK.shipped),
     )
     (MODELS_DIR / "NOTICE.md").write_text(text)
 
@@ -352,9 +391,16 @@ the wheel, checks the sha256 values above, and:
   opset {opset}, renames inputs/outputs (below), stores the weights, which are fp16
   in the sources, as fp16 initializers + Cast (lossless), and names nodes from the
   graph structure;
+- prunes the landmark model to the outputs monopic reads. onnxruntime runs every
+  node of a graph whatever outputs are requested, so unused branches would cost time
+  on every frame. The pruning (`keep_outputs` in `tools/models/onnx_post.py`, which
+  keeps the same nodes as `onnx.utils.extract_model`) only removes nodes, so the kept
+  outputs are computed exactly as in the full conversion. It keeps {keep} and
+  {pruned};
 - writes `tests/data/pose_reference.npz` with the ORIGINAL TFLite models' outputs on
-  fixed inputs, checked by `tests/test_model_fidelity.py`. One input is the public
-  domain Grace Hopper portrait shipped in the `{matplotlib}` wheel.
+  fixed inputs (the outputs the ONNX files keep), checked by
+  `tests/test_model_fidelity.py`. One input is the public domain Grace Hopper
+  portrait shipped in the `{matplotlib}` wheel.
 
 With the pinned environment the outputs are byte-identical from run to run.
 
@@ -378,6 +424,10 @@ Both models take one float32 NHWC RGB image, batch 1, named `image`.
 
 ### `pose_landmark_full.onnx`
 
+Pruned: the TFLite model also outputs a segmentation mask ([1, 256, 256, 1] logits) and
+world landmarks ([1, 117], 39 x (x, y, z) in metres, origin at the hip centre); this
+file has only the three outputs below.
+
 - `image` [1, 256, 256, 3]: RGB scaled to [0, 1] (`u8 / 255`), the ROI crop.
 - `landmarks` [1, 195]: 39 x (x, y, z, visibility, presence). x, y in crop pixels
   (0..256); z in the same pixel scale, depth relative to the hip centre; visibility
@@ -386,10 +436,9 @@ Both models take one float32 NHWC RGB image, batch 1, named `image`.
   keypoints 0 and 1); 35-38 are unused by MediaPipe.
 - `pose_flag` [1, 1]: probability that a pose is present (the graph ends in a
   Sigmoid; MediaPipe's threshold is 0.5).
-- `segmentation` [1, 256, 256, 1]: person mask logits (sigmoid them).
 - `heatmap` [1, 64, 64, 39]: per-landmark heatmap logits, used by MediaPipe's
-  heatmap refinement step (which applies a sigmoid).
-- `world_landmarks` [1, 117]: 39 x (x, y, z) in metres, origin at the hip centre.
+  heatmap refinement step (which applies a sigmoid; monopic does the same step in
+  `monopic/pose/landmarks.py`).
 
 ## Measured fidelity
 
@@ -400,9 +449,7 @@ kernels) on the fixture inputs; "rel" is max |diff| / (1 + |reference|).
 | --- | --- | --- | --- |
 {diffs}
 
-The segmentation logits reach about -1.5e3, so float32 rounding differences add up
-to ~0.4 there; as a mask (after the sigmoid) the difference is below 1e-4. The
-test's tolerances are in `tests/test_model_fidelity.py`.
+The test's tolerances are in `tests/test_model_fidelity.py`.
 """
 
 
@@ -427,8 +474,9 @@ def main(argv: list[str] | None = None) -> int:
     convert_from = {DETECTOR.name: dense, LANDMARK.name: sources[LANDMARK.name]}
 
     MODELS_DIR.mkdir(parents=True, exist_ok=True)
+    pruned: dict[str, str | None] = {}
     for spec in (DETECTOR, LANDMARK):
-        model = to_onnx(spec, convert_from[spec.name], sources[spec.name])
+        model, pruned[spec.name] = to_onnx(spec, convert_from[spec.name], sources[spec.name])
         spec.onnx_path.write_bytes(model.SerializeToString(deterministic=True))
         print(f"wrote {spec.onnx_path.relative_to(REPO)}")
     (MODELS_DIR / "LICENSE").write_text(apache_license(license_text.decode()))
@@ -444,7 +492,9 @@ def main(argv: list[str] | None = None) -> int:
     worst = max(rel for d in diffs.values() for _, rel in d.values())
     if worst > MAX_REL_DIFF:
         raise SystemExit(f"ONNX differs from TFLite by {worst:.3g} (relative) > {MAX_REL_DIFF}")
-    write_notice(diffs)
+    if (landmark_pruned := pruned[LANDMARK.name]) is None:
+        raise SystemExit(f"{LANDMARK.name} was not pruned")
+    write_notice(diffs, landmark_pruned)
     print(f"wrote {(MODELS_DIR / 'NOTICE.md').relative_to(REPO)}")
     return 0
 

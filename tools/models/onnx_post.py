@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 import numpy as np
 import onnx
@@ -116,3 +116,42 @@ def stamp(model: onnx.ModelProto, doc: str, metadata: Mapping[str, str]) -> None
     for key, value in sorted(metadata.items()):
         entry = model.metadata_props.add()
         entry.key, entry.value = key, value
+
+
+def keep_outputs(model: onnx.ModelProto, names: Sequence[str]) -> int:
+    """Keep only the graph outputs `names` (in that order) and the nodes they need.
+
+    onnxruntime executes every node of a graph whatever outputs a caller asks for, so
+    outputs nobody reads still cost their whole branch on every run. Nodes, initializers
+    and value infos that no kept output depends on are removed; the rest is untouched,
+    so the kept outputs compute exactly as before. Returns the number of nodes removed.
+    """
+    graph = model.graph
+    outputs = {o.name: o for o in graph.output}
+    if missing := [n for n in names if n not in outputs]:
+        raise ValueError(f"no graph output named {missing}; outputs are {list(outputs)}")
+    if any(a.type in (onnx.AttributeProto.GRAPH, onnx.AttributeProto.GRAPHS)
+           for node in graph.node for a in node.attribute):  # fmt: skip
+        raise ValueError("graphs with subgraphs (If/Loop/Scan) are not supported")
+    producer = {out: i for i, node in enumerate(graph.node) for out in node.output if out}
+    live: set[int] = set()
+    stack = list(names)
+    while stack:
+        i = producer.get(stack.pop())
+        if i is not None and i not in live:
+            live.add(i)
+            stack.extend(name for name in graph.node[i].input if name)
+    nodes = [node for i, node in enumerate(graph.node) if i in live]
+    used = {name for node in nodes for name in (*node.input, *node.output)}
+    inits = [init for init in graph.initializer if init.name in used]
+    infos = [info for info in graph.value_info if info.name in used]
+    removed = len(graph.node) - len(nodes)
+    for field, values in (
+        (graph.node, nodes),
+        (graph.initializer, inits),
+        (graph.value_info, infos),
+        (graph.output, [outputs[n] for n in names]),
+    ):
+        del field[:]
+        field.extend(values)
+    return removed
