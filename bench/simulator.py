@@ -33,12 +33,18 @@ REALTIME_FPS = 15.0
 CASES = (1, 2, 3, 4, 5, 6, 8)  # walking cases; still (9) has no motion to predict
 
 
-def scenario(case: int, frames: int, seed: int = 0) -> Any:
-    """A case at the default 8 m with the robot driving at 2 m/s, `frames` frames at 15 fps."""
+def scenario(case: int, frames: int, seed: int = 0, shadows: bool = True) -> Any:
+    """A case at the default 8 m with the robot driving at 2 m/s, `frames` frames at 15 fps.
+
+    `shadows=False` is the overcast lighting (no shadow pass in the render).
+    """
+    from dataclasses import replace
+
     from monopic.cases import Case
     from sim.cases import place_case
 
-    return place_case(Case(case), duration=frames / REALTIME_FPS, seed=seed)
+    sc = place_case(Case(case), duration=frames / REALTIME_FPS, seed=seed)
+    return replace(sc, scene=replace(sc.scene, shadows=shadows))
 
 
 def child_render(frames: int) -> dict[str, Any]:
@@ -66,7 +72,7 @@ def child_render(frames: int) -> dict[str, Any]:
     return res
 
 
-def child_run(frames: int, ablation: bool) -> dict[str, Any]:
+def child_run(frames: int, ablation: bool, shadows: bool = True) -> dict[str, Any]:
     """One whole scenario through sim.runner.run, after one warm-up run; frames per second."""
     from sim.runner import RunSpec, run
 
@@ -75,7 +81,7 @@ def child_run(frames: int, ablation: bool) -> dict[str, Any]:
     results = []
     for case in (5, 3):
         spec = RunSpec(
-            id=f"case{case}", scenario=scenario(case, frames), ablation=ablation,
+            id=f"case{case}", scenario=scenario(case, frames, shadows=shadows), ablation=ablation,
             stop_at_contact=False,
         )  # fmt: skip
         cpu0, t0 = time.process_time(), time.perf_counter()
@@ -141,6 +147,7 @@ def main() -> None:
     ap.add_argument("--child", choices=("render", "run", "sweep"), help=argparse.SUPPRESS)
     ap.add_argument("--pin", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--ablation", type=int, default=0, help=argparse.SUPPRESS)
+    ap.add_argument("--shadows", type=int, default=1, help=argparse.SUPPRESS)
     ap.add_argument("--workers", type=int, default=1, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
@@ -149,7 +156,7 @@ def main() -> None:
         if args.child == "render":
             out = child_render(args.frames)
         elif args.child == "run":
-            out = child_run(args.frames, bool(args.ablation))
+            out = child_run(args.frames, bool(args.ablation), bool(args.shadows))
         else:
             out = child_sweep(args.frames, args.runs, args.workers)
         print(json.dumps(out))
@@ -158,7 +165,10 @@ def main() -> None:
     load0 = os.getloadavg()[0]
     start = time.perf_counter()
     render = spawn_child("render", True, frames=args.frames)
-    runs = {ab: spawn_child("run", True, frames=args.frames, ablation=ab) for ab in (0, 1)}
+    runs = {
+        (ab, sh): spawn_child("run", True, frames=args.frames, ablation=ab, shadows=sh)
+        for ab, sh in ((0, 1), (1, 1), (0, 0))
+    }
     sweeps = {
         w: spawn_child("sweep", False, frames=args.frames, runs=args.runs, workers=w)
         for w in (1, 2)
@@ -181,11 +191,12 @@ def main() -> None:
         "| CPU-s per frame | vs real time at 15 fps | peak RSS |",
         "| --- | ---: | ---: | ---: | ---: | ---: |",
     ]
-    for ab, res in runs.items():
+    for (ab, sh), res in runs.items():
         fps = sorted(x["frames"] / x["wall_s"] for x in res["runs"])
         med = (fps[0] + fps[-1]) / 2
         cpu = sum(x["cpu_s"] for x in res["runs"]) / sum(x["frames"] for x in res["runs"])
         name = "render + pipeline (5 predictors)" + (" + ground-truth-crop ablation" if ab else "")
+        name += "" if sh else ", overcast (no shadow pass)"
         lines.append(
             f"| {name} | {res['runs'][0]['frames']} | {med:.1f} ({fps[0]:.1f}-{fps[-1]:.1f}) "
             f"| {1e3 * cpu:.1f} ms | {med / REALTIME_FPS:.2f}x "

@@ -81,7 +81,9 @@ LIGHTING: dict[str, tuple[float, float]] = {
     "morning": (120.0, 25.0),
     "low-sun-behind": (180.0, 10.0),
     "low-sun-ahead": (15.0, 10.0),
+    "overcast": (210.0, 60.0),  # the sun behind clouds: diffuse light, no cast shadows
 }
+SHADOWLESS = frozenset({"overcast"})
 
 BODIES = ("adult", "child")
 

@@ -92,6 +92,7 @@ class SceneSpec:
     occluders: tuple[Occluder, ...] = ()  # e.g. Occluder.parked_car(x, y)
     sun_azimuth_deg: float = 210.0
     sun_elevation_deg: float = 50.0
+    shadows: bool = True  # False: an overcast sky, diffuse light and no cast shadows
     road: RoadLayout = field(default_factory=RoadLayout)  # the street (MuJoCo and highway-env)
 
 

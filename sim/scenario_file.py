@@ -27,6 +27,7 @@ from sim.families import (
     CLOTHING,
     LIGHTING,
     SCALES,
+    SHADOWLESS,
     Crossing,
     Longitudinal,
     PlacementError,
@@ -301,7 +302,11 @@ def build(path: Path, data: Mapping[str, Any]) -> Scenario:
     occluders = _parked_cars(top.table("scene").table("parked_cars"), x_line, robot, road)
     top.done()
     scene = SceneSpec(
-        occluders=occluders, road=road, sun_azimuth_deg=lighting[0], sun_elevation_deg=lighting[1]
+        occluders=occluders,
+        road=road,
+        sun_azimuth_deg=lighting[0],
+        sun_elevation_deg=lighting[1],
+        shadows=lighting[2],
     )
     scenario = Scenario(
         name=name,
@@ -353,7 +358,7 @@ def _camera(t: TomlTable, preset: CameraSpec) -> CameraSpec:
     return camera
 
 
-def _scene(t: TomlTable, preset: RoadLayout) -> tuple[RoadLayout, tuple[float, float]]:
+def _scene(t: TomlTable, preset: RoadLayout) -> tuple[RoadLayout, tuple[float, float, bool]]:
     lighting = t.text("lighting", "noon", tuple(LIGHTING))
     azimuth, elevation = LIGHTING[lighting]
     azimuth = t.number("sun_azimuth_deg", azimuth, low=-360.0, high=360.0, unit="degrees")
@@ -375,7 +380,7 @@ def _scene(t: TomlTable, preset: RoadLayout) -> tuple[RoadLayout, tuple[float, f
     r.done()
     t.seen.add("parked_cars")  # read by _parked_cars once the path is known
     t.done()
-    return road, (azimuth, elevation)
+    return road, (azimuth, elevation, lighting not in SHADOWLESS)
 
 
 def _path(

@@ -50,6 +50,9 @@ class SceneConfig:
     occluders: tuple[Occluder, ...] = ()
     sun_azimuth_deg: float = 210.0  # where the sunlight comes from, CCW from east
     sun_elevation_deg: float = 50.0
+    # False: an overcast sky (diffuse light, no cast shadows); the shadow pass is half the
+    # render time on software GL (bench/simulator.py).
+    shadows: bool = True
     shadow_size: int = 768  # shadow map texels per side (1024: +4 ms a frame, same detections)
     shadow_half_extent: float = 20.0  # m, half-size of the sharp-shadow region
     shadow_centre_ahead: float = 12.0  # m ahead of the robot where that region is centred
@@ -118,8 +121,9 @@ def build_spec(config: SceneConfig) -> mujoco.MjSpec:
     vis.map.znear = NEAR_CLIP / SCENE_EXTENT
     vis.map.zfar = FAR_CLIP / SCENE_EXTENT
     vis.map.shadowclip = config.shadow_half_extent / SCENE_EXTENT
-    vis.headlight.ambient = [0.32, 0.32, 0.33]
-    vis.headlight.diffuse = [0.25, 0.25, 0.25]
+    # Overcast: more sky light from everywhere, a weak sun that casts nothing.
+    vis.headlight.ambient = [0.32, 0.32, 0.33] if config.shadows else [0.5, 0.5, 0.52]
+    vis.headlight.diffuse = [0.25, 0.25, 0.25] if config.shadows else [0.3, 0.3, 0.3]
     vis.headlight.specular = [0.0, 0.0, 0.0]
 
     spec.add_texture(
@@ -143,8 +147,8 @@ def build_spec(config: SceneConfig) -> mujoco.MjSpec:
         type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
         pos=(-60.0 * direction).tolist(),
         dir=direction.tolist(),
-        castshadow=True,
-        diffuse=[0.78, 0.76, 0.72],
+        castshadow=config.shadows,
+        diffuse=[0.78, 0.76, 0.72] if config.shadows else [0.35, 0.35, 0.36],
         ambient=[0.12, 0.12, 0.13],
         specular=[0.15, 0.15, 0.15],
     )

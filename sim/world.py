@@ -84,6 +84,7 @@ class World:
                 occluders=scene_spec.occluders,
                 sun_azimuth_deg=scene_spec.sun_azimuth_deg,
                 sun_elevation_deg=scene_spec.sun_elevation_deg,
+                shadows=scene_spec.shadows,
             )
         )
         self._renderer: SceneRenderer | None = None

@@ -211,3 +211,13 @@ def test_near_misses_and_a_standing_robot_never_meet_the_pedestrian(file: str) -
     if "cpna" in file:
         assert scenario.case is Case.PERPENDICULAR_LEFT
     assert math.isfinite(scenario.horizon)
+
+
+def test_overcast_lighting_turns_the_shadow_pass_off(tmp_path: Path) -> None:
+    sunny = load(write(tmp_path, BASE, "sunny.toml")).base
+    overcast = load(write(tmp_path, BASE + '[scene]\nlighting = "overcast"\n', "o.toml")).base
+    assert sunny.scene.shadows and not overcast.scene.shadows
+    with World(overcast, render=False) as world:
+        assert not world.scene.model.light_castshadow.any()
+    with World(sunny, render=False) as world:
+        assert world.scene.model.light_castshadow.any()
