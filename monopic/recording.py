@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
+from types import TracebackType
 
 import cv2
 import numpy as np
@@ -266,3 +267,18 @@ class RunRecording:
         """Drop the partial recording."""
         self.rec.disconnect()
         self.tmp.unlink(missing_ok=True)
+
+    def __enter__(self) -> RunRecording:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        """Whole or nothing: the file appears only when the run ended without an error."""
+        if exc_type is None:
+            self.close()
+        else:
+            self.abort()

@@ -27,6 +27,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -145,17 +146,9 @@ def run_closed_loop(
         world: World = env.unwrapped.world
         pipeline = None if policy in (NO_BRAKE, ORACLE) else policy_pipeline(scenario, policy)
         brake = LatencyBrake(scenario.dt, scenario.robot.max_deceleration)
-        recording = SimRecording(rrd, world) if rrd is not None else None
-        try:
-            outcome = _loop(env, world, scenario, policy, pipeline, brake, latency_ms, recording,
-                            seed, on_frame)  # fmt: skip
-        except BaseException:
-            if recording is not None:
-                recording.abort()
-            raise
-        if recording is not None:
-            recording.close()
-        return outcome
+        with SimRecording(rrd, world) if rrd is not None else nullcontext() as recording:
+            return _loop(env, world, scenario, policy, pipeline, brake, latency_ms, recording,
+                         seed, on_frame)  # fmt: skip
     finally:
         env.close()
 

@@ -85,33 +85,26 @@ def run(args: argparse.Namespace) -> int:
         if args.rrd is not None:
             from monopic.recording import RunRecording
 
-            recording = RunRecording(args.rrd)
-        try:
-            last = time.perf_counter()
-            fps_now = 0.0
-            bar = tqdm(source, total=source.frame_count, unit="frame", desc=Path(args.input).name)
-            for frame in bar:
-                result = pipeline.process(frame)
-                frames += 1
-                found += result.pose.found
-                now = time.perf_counter()
-                fps_now = 1.0 / max(now - last, 1e-6)
-                last = now
-                if writer is not None:
-                    annotated = draw(frame.image, result, variant, fps_now)
-                    writer.write(cv2.cvtColor(annotated, cv2.COLOR_RGB2BGR))
-                if csv_writer is not None and result.features is not None:
-                    row = frame_row(result, fps_now, args.horizon)
-                    if authors_finite(row):
-                        csv_writer.writerow(row)
-                if recording is not None:
-                    recording.log_frame(frame.image, result)
-        except BaseException:
+            recording = stack.enter_context(RunRecording(args.rrd))
+        last = time.perf_counter()
+        fps_now = 0.0
+        bar = tqdm(source, total=source.frame_count, unit="frame", desc=Path(args.input).name)
+        for frame in bar:
+            result = pipeline.process(frame)
+            frames += 1
+            found += result.pose.found
+            now = time.perf_counter()
+            fps_now = 1.0 / max(now - last, 1e-6)
+            last = now
+            if writer is not None:
+                annotated = draw(frame.image, result, variant, fps_now)
+                writer.write(cv2.cvtColor(annotated, cv2.COLOR_RGB2BGR))
+            if csv_writer is not None and result.features is not None:
+                row = frame_row(result, fps_now, args.horizon)
+                if authors_finite(row):
+                    csv_writer.writerow(row)
             if recording is not None:
-                recording.abort()
-            raise
-        if recording is not None:
-            recording.close()
+                recording.log_frame(frame.image, result)
     print(f"{frames} frames, person found in {found} ({100 * found / max(frames, 1):.0f} %)")
     for label, path in (("video", args.out), ("csv", args.csv), ("recording", args.rrd)):
         if path is not None:
