@@ -20,6 +20,7 @@ from sim.frames import yaw_quat
 RGB = tuple[float, float, float]
 PAINT_HEIGHT = 0.004  # m, top of the road markings above the asphalt
 SLAB_DEPTH = 0.1  # m, thickness of the road and pavement boxes below z = 0
+GROUND_DEPTH = 0.1  # m, thickness of the grass box whose top is 1 cm below the road
 
 
 @dataclass(frozen=True)
@@ -156,16 +157,16 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occlude
     paint = _material(spec, "paint", (0.92, 0.92, 0.9, 1), specular=0.1)
     kerb = _material(spec, "kerb", (0.72, 0.71, 0.68, 1))
 
+    # The ground is a thin box, not a plane: MuJoCo draws a plane as a dense grid of quads,
+    # which cost software GL 16 ms of a 46 ms frame (most of it in the shadow passes) for
+    # the same image (bench/simulator.py; BENCHMARKS.md, session 3).
     extent = road.length * 1.5
-    spec.worldbody.add_geom(
-        name="ground",
-        type=mujoco.mjtGeom.mjGEOM_PLANE,
-        pos=[0, road.center_y, -0.01],
-        size=[extent, extent, 1.0],
-        material=grass,
-        contype=0,
-        conaffinity=0,
-        group=0,
+    _box(
+        spec,
+        "ground",
+        (0, road.center_y, -0.01 - GROUND_DEPTH / 2),
+        (extent, extent, GROUND_DEPTH / 2),
+        grass,
     )
     half_len = road.length / 2
     y_right, y_left = road.edges
