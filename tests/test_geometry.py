@@ -13,7 +13,12 @@ from monopic.pose.anchors import ssd_anchor_centres
 from monopic.pose.detector import Detection, letterbox, weighted_nms
 from monopic.pose.region import Region
 from monopic.pose.search import Window, tile_windows
-from monopic.variants.zone import RobotGeometry, meets_swept_footprint, point_in_polygon
+from monopic.variants.zone import (
+    RobotGeometry,
+    meets_swept_footprint,
+    point_in_polygon,
+    points_in_polygon,
+)
 
 CAM = CameraModel.from_fov(768, 432, 70, 1.1, pitch_deg=8, mount_forward=0.3)
 
@@ -130,6 +135,24 @@ def test_point_in_polygon():
     assert point_in_polygon((5, 5), sq)
     assert not point_in_polygon((15, 5), sq)
     assert not point_in_polygon((float("nan"), 5), sq)
+
+
+coord = st.floats(-50, 850, allow_nan=False)
+
+
+@given(st.lists(st.tuples(coord, coord), min_size=1, max_size=30))
+def test_points_in_polygon_agrees_with_half_planes_on_the_image_zone(points):
+    """The even-odd rule against an independent test: inside all edges of a convex polygon."""
+    zone = np.array([[268.8, 237.6], [499.2, 237.6], [652.8, 432.0], [115.2, 432.0]])
+    pts = np.array(points)
+    edge = np.roll(zone, -1, axis=0) - zone
+    rel = pts[:, None, :] - zone[None, :, :]
+    cross = edge[None, :, 0] * rel[..., 1] - edge[None, :, 1] * rel[..., 0]
+    strictly = np.all(cross > 1e-6, axis=1)  # clockwise on screen: interior on the left
+    outside = np.any(cross < -1e-6, axis=1)
+    got = points_in_polygon(pts, zone)
+    assert np.all(got[strictly]) and not np.any(got[outside])
+    assert [point_in_polygon(tuple(p), zone) for p in pts] == got.tolist()
 
 
 def test_swept_footprint_meets_a_crossing_pedestrian():

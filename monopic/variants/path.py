@@ -12,7 +12,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from monopic.predict.base import Features, Prediction
-from monopic.variants.zone import point_in_polygon
+from monopic.variants.zone import points_in_polygon
 
 
 @dataclass(frozen=True)
@@ -54,7 +54,6 @@ def project_path(
         )
         ok = np.all(np.isfinite(pts), axis=1)
         image_path = np.where(ok[:, None], pts, image_path)
-    conflict = next(
-        (i for i, p in enumerate(image_path) if point_in_polygon((p[0], p[1]), zone)), None
-    )
+    hits = np.flatnonzero(points_in_polygon(image_path, zone))
+    conflict = int(hits[0]) if hits.size else None
     return PathProjection(times, image_path, ground_path, conflict)

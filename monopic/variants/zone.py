@@ -70,20 +70,27 @@ def default_image_zone(width: int, height: int) -> np.ndarray:
     )
 
 
+def points_in_polygon(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
+    """Even-odd rule for (N, 2) points at once; False for non-finite points.
+
+    Vectorised because the path projection tests every point of every predictor's path
+    in every frame.
+    """
+    pts = np.asarray(points, dtype=float).reshape(-1, 2)
+    x, y = pts[:, :1], pts[:, 1:]  # (N, 1) against the polygon's edges along axis 1
+    poly = np.asarray(polygon, dtype=float)
+    x1, y1 = poly[:, 0], poly[:, 1]
+    x2, y2 = np.roll(x1, -1), np.roll(y1, -1)
+    crosses = (y1 > y) != (y2 > y)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        xi = x1 + (y - y1) * (x2 - x1) / (y2 - y1)
+    inside = (np.count_nonzero(crosses & (x < xi), axis=1) % 2) == 1
+    return inside & np.all(np.isfinite(pts), axis=1)
+
+
 def point_in_polygon(point: tuple[float, float], polygon: np.ndarray) -> bool:
-    """Even-odd rule; False for non-finite points."""
-    x, y = point
-    if not (math.isfinite(x) and math.isfinite(y)):
-        return False
-    inside = False
-    n = len(polygon)
-    for i in range(n):
-        (x1, y1), (x2, y2) = polygon[i], polygon[(i + 1) % n]
-        if (y1 > y) != (y2 > y):
-            xi = x1 + (y - y1) * (x2 - x1) / (y2 - y1)
-            if x < xi:
-                inside = not inside
-    return inside
+    """Even-odd rule for one point; False for a non-finite point."""
+    return bool(points_in_polygon(np.array([point], dtype=float), polygon)[0])
 
 
 def robot_pose_at(speed: float, yaw_rate: float, tau: float) -> tuple[float, float, float]:
