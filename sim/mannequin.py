@@ -648,20 +648,32 @@ def geom_z_extent(
     centre = data.geom_xpos[geoms, 2]
     zrow = data.geom_xmat[geoms].reshape(-1, 3, 3)[:, 2, :]  # world z of each local axis
     size = model.geom_size[geoms]
-    types = model.geom_type[geoms]
+    kind = _geom_kinds(model, geoms, "the z extent")
     half = np.zeros(len(geoms))
-    for k, t in enumerate(types):
-        if t == mujoco.mjtGeom.mjGEOM_SPHERE:
-            half[k] = size[k, 0]
-        elif t == mujoco.mjtGeom.mjGEOM_CAPSULE:
-            half[k] = size[k, 0] + abs(zrow[k, 2]) * size[k, 1]
-        elif t == mujoco.mjtGeom.mjGEOM_ELLIPSOID:
-            half[k] = np.linalg.norm(size[k] * zrow[k])
-        elif t == mujoco.mjtGeom.mjGEOM_BOX:
-            half[k] = np.abs(size[k] * zrow[k]).sum()
-        else:
-            raise ValueError(f"unsupported geom type {t} for the z extent")
+    sphere, capsule = kind == mujoco.mjtGeom.mjGEOM_SPHERE, kind == mujoco.mjtGeom.mjGEOM_CAPSULE
+    ellipsoid, box = kind == mujoco.mjtGeom.mjGEOM_ELLIPSOID, kind == mujoco.mjtGeom.mjGEOM_BOX
+    half[sphere] = size[sphere, 0]
+    half[capsule] = size[capsule, 0] + np.abs(zrow[capsule, 2]) * size[capsule, 1]
+    half[ellipsoid] = np.linalg.norm(size[ellipsoid] * zrow[ellipsoid], axis=1)
+    half[box] = np.abs(size[box] * zrow[box]).sum(axis=1)
     return centre - half, centre + half
+
+
+SURFACE_KINDS = (
+    mujoco.mjtGeom.mjGEOM_SPHERE,
+    mujoco.mjtGeom.mjGEOM_CAPSULE,
+    mujoco.mjtGeom.mjGEOM_ELLIPSOID,
+    mujoco.mjtGeom.mjGEOM_BOX,
+)
+
+
+def _geom_kinds(model: mujoco.MjModel, geoms: np.ndarray, purpose: str) -> np.ndarray:
+    """The geoms' types, checked to be ones the vectorised helpers here handle."""
+    kind = model.geom_type[geoms]
+    bad = ~(kind[:, None] == np.array(SURFACE_KINDS, dtype=int)).any(axis=1)
+    if bad.any():
+        raise ValueError(f"unsupported geom type {kind[bad][0]} for {purpose}")
+    return kind
 
 
 def _unit_sphere(n: int) -> np.ndarray:
@@ -676,24 +688,21 @@ def _unit_sphere(n: int) -> np.ndarray:
 def geom_surface_points(
     model: mujoco.MjModel, data: mujoco.MjData, geoms: np.ndarray, n: int = 98
 ) -> np.ndarray:
-    """World points (len(geoms) * n, 3) on the surfaces of the given geoms."""
+    """World points (len(geoms) * n, 3) on the surfaces of the given geoms, geom by geom.
+
+    Vectorised over geoms (ground truth asks for it every frame).
+    """
     dirs = _unit_sphere(n)
-    out = []
-    for g in geoms:
-        c = data.geom_xpos[g]
-        rot = data.geom_xmat[g].reshape(3, 3)
-        s = model.geom_size[g]
-        t = model.geom_type[g]
-        if t == mujoco.mjtGeom.mjGEOM_SPHERE:
-            local = dirs * s[0]
-        elif t == mujoco.mjtGeom.mjGEOM_CAPSULE:
-            local = dirs * s[0]
-            local[:, 2] += np.sign(dirs[:, 2]) * s[1]
-        elif t == mujoco.mjtGeom.mjGEOM_ELLIPSOID:
-            local = dirs * s[:3]
-        elif t == mujoco.mjtGeom.mjGEOM_BOX:
-            local = np.sign(dirs) * s[:3]
-        else:
-            raise ValueError(f"unsupported geom type {t} for surface points")
-        out.append(c + local @ rot.T)
-    return np.concatenate(out, axis=0)
+    size = model.geom_size[geoms]
+    kind = _geom_kinds(model, geoms, "surface points")
+    round_ = (kind == mujoco.mjtGeom.mjGEOM_SPHERE) | (kind == mujoco.mjtGeom.mjGEOM_CAPSULE)
+    box = kind == mujoco.mjtGeom.mjGEOM_BOX
+    # Spheres and capsules scale the directions by the radius, ellipsoids and boxes per axis.
+    scale = np.where(round_[:, None], size[:, :1], size[:, :3])  # (G, 3)
+    shape = np.where(box[:, None, None], np.sign(dirs)[None], dirs[None])  # (G, n, 3)
+    local = shape * scale[:, None, :]
+    capsule = kind == mujoco.mjtGeom.mjGEOM_CAPSULE
+    local[capsule, :, 2] += np.sign(dirs[:, 2])[None, :] * size[capsule, 1][:, None]
+    rot = data.geom_xmat[geoms].reshape(-1, 3, 3)
+    world = data.geom_xpos[geoms][:, None, :] + np.einsum("gnj,gij->gni", local, rot)
+    return world.reshape(-1, 3)
