@@ -129,7 +129,7 @@ class Pipeline:
         h, w = frame.image.shape[:2]
         timer = StageTimer()
         band = GroundBand.from_camera(frame.ego.camera) if frame.ego is not None else None
-        pose = self.tracker.process(frame.image, region, band)
+        pose = self.tracker.process(frame.image, region, band, frame.timestamp)
         timer.lap("pose")
         feats = self.features.update(frame.timestamp, pose.pose, h, frame.ego)
         timer.lap("features")

@@ -1,18 +1,26 @@
 """The tracker's search budget: a pedestrian too small for the whole frame is found by the
-tile cascade, spread over frames, with no frame spending more detector passes than allowed."""
+tile cascade, spread over frames, with no frame spending more detector passes than allowed.
+And its landmark filtering across frames: on with timestamps, restarted with each track
+(with scripted models, fast), and smoother on the clip (real models, slow)."""
+
+from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import cv2
 import numpy as np
 import pytest
 
+import monopic.pose.tracker as tracker_module
+from monopic.pose.detector import Detection
+from monopic.pose.filtering import LandmarkFilter
+from monopic.pose.landmarks import Pose
+from monopic.pose.region import Region
 from monopic.pose.search import tile_windows
 from monopic.pose.tracker import PoseTracker, TrackerConfig
 from monopic.video import VideoSource
 from tests.test_end_to_end import CLIP
-
-pytestmark = pytest.mark.slow
 
 
 def small_person_frame(scale: float = 0.2) -> np.ndarray:
@@ -31,6 +39,7 @@ def tiles_in_cascade(config: TrackerConfig, width: int = 768, height: int = 432)
     )
 
 
+@pytest.mark.slow
 def test_unlimited_search_finds_the_small_person_in_the_first_frame():
     tracker = PoseTracker(TrackerConfig(search_budget=0))
     first = tracker.process(small_person_frame())
@@ -38,6 +47,7 @@ def test_unlimited_search_finds_the_small_person_in_the_first_frame():
     assert first.detector_runs > 4  # the whole frame missed it; the tiles found it
 
 
+@pytest.mark.slow
 def test_budgeted_search_spreads_the_cascade_over_frames_and_then_tracks():
     config = TrackerConfig(search_budget=4)
     tracker = PoseTracker(config)
@@ -55,3 +65,172 @@ def test_search_budget_must_leave_room_for_a_tile():
         TrackerConfig(search_budget=1)
     with pytest.raises(ValueError, match="search_budget"):
         TrackerConfig(search_budget=-2)
+
+
+@pytest.mark.slow
+def test_timestamps_smooth_the_clip_track():
+    """On the clip, the filtered track has less frame-to-frame jitter than the raw one
+    (second differences of the landmark positions) and stays within a few pixels of it."""
+    frames = list(VideoSource(str(CLIP)))[:30]
+    raw_tracker, smooth_tracker = PoseTracker(), PoseTracker()
+    raw = [raw_tracker.process(f.image).pose for f in frames]
+    smooth = [smooth_tracker.process(f.image, timestamp=f.timestamp).pose for f in frames]
+    assert all(p is not None for p in raw + smooth)
+    raw_xy = np.stack([p.landmarks[:, :2] for p in raw])
+    smooth_xy = np.stack([p.landmarks[:, :2] for p in smooth])
+    jitter = lambda xy: float(np.abs(np.diff(xy, n=2, axis=0)).mean())  # noqa: E731
+    assert jitter(smooth_xy) < 0.8 * jitter(raw_xy)
+    assert np.median(np.linalg.norm(smooth_xy - raw_xy, axis=2)) < 3.0
+
+
+# Scripted models: the tracker's filtering logic without running a network.
+
+IMAGE = np.zeros((432, 768, 3), dtype=np.uint8)
+
+
+def scripted_pose(k: int, score: float = 0.99) -> Pose:
+    """Frame k of a jittery walker moving right at 4 px per frame, ~100 px tall."""
+    rng = np.random.default_rng(k)
+    base = np.random.default_rng(0).uniform(0, 100, (33, 3))
+    lm = base + [300.0 + 4 * k, 150.0, 0.0] + rng.normal(0, 1.5, (33, 3))
+    aux = np.array([[350.0 + 4 * k, 200.0], [350.0 + 4 * k, 140.0]] + [[0.0, 0.0]] * 4)
+    aux = aux + rng.normal(0, 1.5, aux.shape)
+    return Pose(
+        landmarks=lm,
+        visibility=rng.uniform(0.2, 1.0, 33),
+        presence=np.full(33, 0.9),
+        score=score,
+        region=Region(350.0, 200.0, 150.0),
+        aux=aux,
+    )
+
+
+class ScriptedLandmarks:
+    def __init__(self, *args) -> None:
+        self.script: list[Pose] = []
+        self.regions: list[Region] = []  # the region of every run
+
+    def run(self, image: np.ndarray, region: Region) -> Pose:
+        self.regions.append(region)
+        return replace(self.script.pop(0), region=region)
+
+
+class ScriptedDetector:
+    def __init__(self, *args) -> None:
+        self.finds: list[bool] = []  # per detect() call: somebody there or not
+
+    def detect(self, image: np.ndarray, windows=None) -> list[Detection]:
+        if not self.finds.pop(0):
+            return []
+        kps = np.array([[350.0, 200.0], [350.0, 140.0], [350.0, 160.0], [350.0, 120.0]])
+        return [Detection(0.9, (300.0, 100.0, 400.0, 300.0), kps)]
+
+
+@pytest.fixture
+def scripted(monkeypatch) -> PoseTracker:
+    monkeypatch.setattr(tracker_module, "LandmarkModel", ScriptedLandmarks)
+    monkeypatch.setattr(tracker_module, "PoseDetector", ScriptedDetector)
+    # No tiles: one detector call per acquiring frame.
+    return PoseTracker(TrackerConfig(acquire_tiles=(), far_tiles=()))
+
+
+def feed(tracker: PoseTracker, poses: list[Pose], finds: list[bool]) -> None:
+    tracker.landmarks.script = list(poses)
+    tracker.detector.finds = list(finds)
+
+
+def test_without_timestamps_the_tracker_returns_the_models_poses(scripted):
+    poses = [scripted_pose(k) for k in range(6)]
+    feed(scripted, poses, [True])
+    out = [scripted.process(IMAGE).pose for _ in poses]
+    for got, want in zip(out, poses, strict=True):
+        np.testing.assert_array_equal(got.landmarks, want.landmarks)
+        np.testing.assert_array_equal(got.visibility, want.visibility)
+        np.testing.assert_array_equal(got.aux, want.aux)
+    # Each next region comes from the raw auxiliary points.
+    for k in range(1, len(poses)):
+        assert scripted.landmarks.regions[k] == poses[k - 1].next_region()
+
+
+def test_with_timestamps_landmarks_and_next_region_are_smoothed(scripted):
+    poses = [scripted_pose(k) for k in range(6)]
+    feed(scripted, poses, [True])
+    out = [scripted.process(IMAGE, timestamp=k / 15).pose for k in range(len(poses))]
+    oracle = LandmarkFilter()
+    for k, (got, raw) in enumerate(zip(out, poses, strict=True)):
+        want = oracle.apply(raw, k / 15)
+        np.testing.assert_array_equal(got.landmarks, want.landmarks)
+        np.testing.assert_array_equal(got.visibility, want.visibility)
+        if k:
+            assert not np.allclose(got.landmarks, raw.landmarks)
+            assert scripted.landmarks.regions[k] == out[k - 1].next_region()
+        if k >= 2:  # (frame 0's pose, the filters' first sample, is raw)
+            assert scripted.landmarks.regions[k] != poses[k - 1].next_region()
+    np.testing.assert_array_equal(out[0].landmarks, poses[0].landmarks)  # first: as is
+
+
+def test_smoothing_can_be_switched_off(monkeypatch):
+    monkeypatch.setattr(tracker_module, "LandmarkModel", ScriptedLandmarks)
+    monkeypatch.setattr(tracker_module, "PoseDetector", ScriptedDetector)
+    tracker = PoseTracker(TrackerConfig(smooth_landmarks=False, smooth_region=False))
+    poses = [scripted_pose(k) for k in range(4)]
+    feed(tracker, poses, [True])
+    for k, want in enumerate(poses):
+        got = tracker.process(IMAGE, timestamp=k / 15).pose
+        np.testing.assert_array_equal(got.landmarks, want.landmarks)
+        np.testing.assert_array_equal(got.aux, want.aux)
+
+
+def test_the_filter_restarts_when_the_person_is_lost(scripted):
+    a0, a1, b = scripted_pose(0), scripted_pose(1), scripted_pose(9)
+    lost = scripted_pose(2, score=0.1)
+    # Frame 0: detect, a0. Frame 1: a1 (tracked). Frame 2: landmarks fail, the detector
+    # finds nobody: lost. Frame 3: detect, b.
+    feed(scripted, [a0, a1, lost, b], [True, False, True])
+    assert scripted.process(IMAGE, timestamp=0.0).found
+    assert scripted.process(IMAGE, timestamp=1 / 15).found
+    assert not scripted.process(IMAGE, timestamp=2 / 15).found
+    got = scripted.process(IMAGE, timestamp=3 / 15).pose
+    # A fresh track: b comes back as is, not blended with a1.
+    np.testing.assert_array_equal(got.landmarks, b.landmarks)
+    np.testing.assert_array_equal(got.visibility, b.visibility)
+    np.testing.assert_array_equal(got.aux, b.aux)
+
+
+def test_the_filter_restarts_when_the_person_is_found_again_in_the_same_frame(scripted):
+    a0, b = scripted_pose(0), scripted_pose(9)
+    lost = scripted_pose(1, score=0.1)
+    # Frame 1: the tracked region fails, the detector finds someone at once: b.
+    feed(scripted, [a0, lost, b], [True, True])
+    scripted.process(IMAGE, timestamp=0.0)
+    got = scripted.process(IMAGE, timestamp=1 / 15).pose
+    np.testing.assert_array_equal(got.landmarks, b.landmarks)
+
+
+@pytest.mark.parametrize("how", ["reset", "region"])
+def test_reset_and_a_given_region_restart_the_filter(scripted, how):
+    a0, a1 = scripted_pose(0), scripted_pose(1)
+    feed(scripted, [a0, a1], [True, True])
+    scripted.process(IMAGE, timestamp=0.0)
+    if how == "reset":
+        scripted.reset()
+        got = scripted.process(IMAGE, timestamp=1 / 15).pose
+    else:
+        got = scripted.process(IMAGE, Region(350.0, 170.0, 150.0), timestamp=1 / 15).pose
+    np.testing.assert_array_equal(got.landmarks, a1.landmarks)
+
+
+def test_the_filter_restarts_after_a_frame_where_nobody_is_found(scripted):
+    """The track can also end without a failed landmark pass: a pose whose next region
+    is degenerate (here 0.75 px) sends the next frame to the detector, which finds
+    nobody."""
+    a0, b = scripted_pose(0), scripted_pose(9)
+    a1 = scripted_pose(1)
+    a1.aux[1] = a1.aux[0] + [0.0, -0.3]
+    feed(scripted, [a0, a1, b], [True, False, True])
+    assert scripted.process(IMAGE, timestamp=0.0).found
+    assert scripted.process(IMAGE, timestamp=1 / 15).found
+    assert not scripted.process(IMAGE, timestamp=2 / 15).found
+    got = scripted.process(IMAGE, timestamp=3 / 15).pose
+    np.testing.assert_array_equal(got.landmarks, b.landmarks)
+    np.testing.assert_array_equal(got.visibility, b.visibility)

@@ -10,6 +10,9 @@ once) and the next tiles of the cascade, which resumes where the previous frame 
 Track: crop the rotated region, run the
 landmark model, take the next frame's region from this frame's auxiliary points. When the
 pose flag drops, the person is lost and the detector runs again (in the same frame).
+Filter: given frame timestamps, landmarks, visibility and the auxiliary points are smoothed
+across frames as MediaPipe's PoseLandmarkFiltering does (monopic.pose.filtering), and the
+next region comes from the smoothed auxiliary points; the filters restart with each track.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from monopic.pose.detector import PoseDetector
+from monopic.pose.filtering import LandmarkFilter
 from monopic.pose.landmarks import LandmarkModel, Pose
 from monopic.pose.region import DEFAULT_SCALE, Region
 from monopic.pose.search import GroundBand, Window, search_windows
@@ -39,6 +43,12 @@ class TrackerConfig:
     # Detector passes per frame while searching: the whole frame + (budget - 1) tiles of
     # the cascade. 0 runs the whole cascade in every frame (offline, no time limit).
     search_budget: int = 6
+    # With frame timestamps: smooth landmarks and visibility across frames (MediaPipe
+    # Pose's smooth_landmarks, on by default there too).
+    smooth_landmarks: bool = True
+    # With frame timestamps: build the next region from smoothed auxiliary points.
+    # MediaPipe always does; False only for ablations.
+    smooth_region: bool = True
 
     def __post_init__(self) -> None:
         if self.search_budget < 0 or self.search_budget == 1 and self.acquire_tiles:
@@ -71,24 +81,34 @@ class PoseTracker:
         self.landmarks = LandmarkModel(self.config.threads)
         self._region: Region | None = None
         self._next_tile = 0  # where the search resumes in the tile cascade
+        self._filter = LandmarkFilter(self.config.smooth_landmarks, self.config.smooth_region)
 
     def reset(self) -> None:
         """Forget the tracked person (e.g. at a cut in the video)."""
         self._region = None
         self._next_tile = 0
+        self._filter.reset()
 
     def process(
-        self, image: np.ndarray, region: Region | None = None, band: GroundBand | None = None
+        self,
+        image: np.ndarray,
+        region: Region | None = None,
+        band: GroundBand | None = None,
+        timestamp: float | None = None,
     ) -> PoseResult:
         """Landmarks of the tracked person in this RGB frame.
 
         `region`, when given, replaces detection and tracking for this frame (used to feed
-        a known crop, e.g. for ablations); the next frame tracks from its result. `band`,
-        from the camera model when known, narrows the search to where people can stand.
+        a known crop, e.g. for ablations; it restarts the filters); the next frame tracks
+        from its result. `band`, from the camera model when known, narrows the search to
+        where people can stand. `timestamp` (s), when given, turns on the filtering across
+        frames (TrackerConfig.smooth_landmarks / smooth_region); without it the pose is
+        the landmark model's alone and the filters' state is left as it is.
         """
         runs, detect_ms, landmark_ms = 0, 0.0, 0.0
         if region is not None:
             self._region = region
+            self._filter.reset()
         for attempt in range(2):
             if self._region is None:
                 t0 = time.perf_counter()
@@ -101,12 +121,16 @@ class PoseTracker:
             pose = self.landmarks.run(image, self._region)
             landmark_ms += (time.perf_counter() - t0) * 1e3
             if pose.score >= self.config.min_pose_score:
+                if timestamp is not None:
+                    pose = self._filter.apply(pose, timestamp)
                 next_region = pose.next_region(self.config.region_scale)
                 self._region = next_region if next_region.valid else None
                 return PoseResult(pose, runs, detect_ms, landmark_ms)
             self._region = None
+            self._filter.reset()  # lost: MediaPipe's filters reset on a frame without pose
             if attempt == 0 and runs > 0:
                 break  # fresh detection already failed the landmark check
+        self._filter.reset()
         return PoseResult(None, runs, detect_ms, landmark_ms)
 
     def _acquire(self, image: np.ndarray, band: GroundBand | None) -> tuple[Region | None, int]:
