@@ -41,8 +41,10 @@ class TrackerConfig:
     far_tiles: tuple[int, ...] = (96,)
     tile_overlap: float = 0.25
     # Detector passes per frame while searching: the whole frame + (budget - 1) tiles of
-    # the cascade. 0 runs the whole cascade in every frame (offline, no time limit).
-    search_budget: int = 6
+    # the cascade. 0 runs the whole cascade in every frame (offline, no time limit). 4
+    # passes (about 55 ms on one core) keep a searching frame within a 15 fps frame
+    # period; 6 found far pedestrians 2 frames sooner on average (BENCHMARKS.md).
+    search_budget: int = 4
     # With frame timestamps: smooth landmarks and visibility across frames (MediaPipe
     # Pose's smooth_landmarks, on by default there too).
     smooth_landmarks: bool = True
