@@ -1,7 +1,8 @@
 """onnxruntime sessions with an explicit thread budget.
 
 Parallel sweep workers each run their own pipeline; sessions that spin-wait or take every
-core would fight, so the thread count is always explicit and spinning is off.
+core would fight, so the thread count is always explicit; one thread (what sweep workers use)
+never spins.
 """
 
 from __future__ import annotations
@@ -26,7 +27,7 @@ def model_path(name: str) -> Path:
 
 
 def make_session(path: Path, threads: int = 1) -> ort.InferenceSession:
-    """A CPU session using exactly `threads` intra-op threads and no spin-waiting."""
+    """A CPU session using exactly `threads` intra-op threads."""
     if threads < 1:
         raise ValueError(f"threads must be >= 1, got {threads}")
     opts = ort.SessionOptions()
@@ -34,6 +35,11 @@ def make_session(path: Path, threads: int = 1) -> ort.InferenceSession:
     opts.inter_op_num_threads = 1
     opts.execution_mode = ort.ExecutionMode.ORT_SEQUENTIAL
     opts.graph_optimization_level = ort.GraphOptimizationLevel.ORT_ENABLE_ALL
-    opts.add_session_config_entry("session.intra_op.allow_spinning", "0")
+    # One thread: no pool, nothing to spin. Several threads serve one pipeline's latency
+    # (sweep workers always use one): short spins before each parallel section, and
+    # dynamic blocks that let a thread the VM delayed catch up (bench/compare_reference.py).
+    opts.add_session_config_entry("session.intra_op.allow_spinning", "1" if threads > 1 else "0")
+    if threads > 1:
+        opts.add_session_config_entry("session.dynamic_block_base", "4")
     opts.add_session_config_entry("session.inter_op.allow_spinning", "0")
     return ort.InferenceSession(str(path), sess_options=opts, providers=["CPUExecutionProvider"])
