@@ -4,7 +4,10 @@ The GL backend is the one MUJOCO_GL names, egl by default (set here and in sim/_
 before mujoco is imported; a value already in the environment wins). The renderer makes
 its own context for that backend instead of relying on the one mujoco picked when it
 was first imported. EGL contexts do not survive fork: create renderers inside each
-worker process (spawn).
+worker process (spawn). Mesa's llvmpipe compiles its shaders once per context, which makes
+the first scene drawn in a fresh context about 0.2 s slower: a process that renders many
+scenarios one after another (a sweep worker) keeps one RenderContext and lends it to each
+renderer.
 """
 
 from __future__ import annotations
@@ -57,24 +60,80 @@ def _gl_context(width: int, height: int) -> GLContext:
     return Context(width, height)
 
 
-class SceneRenderer:
-    """Renders the robot camera of a Scene at the camera model's image size."""
+def _unavailable(err: Exception) -> GLUnavailableError:
+    backend = os.environ.get("MUJOCO_GL", "egl")
+    return GLUnavailableError(
+        f"cannot create an offscreen OpenGL context (MUJOCO_GL={backend!r}): {err}. "
+        f"Install the EGL/Mesa packages: apt-get install {' '.join(GL_PACKAGES)}"
+    )
 
-    def __init__(self, scene: Scene, max_geom: int = 2000) -> None:
+
+class RenderContext:
+    """An offscreen OpenGL context that renderers can use one after another.
+
+    Images up to width x height; renderers given one borrow it and leave it open.
+    """
+
+    def __init__(self, width: int, height: int) -> None:
+        self.width, self.height = width, height
+        try:
+            self._gl: GLContext | None = _gl_context(width, height)
+        except Exception as err:  # ImportError, OSError, RuntimeError
+            raise _unavailable(err) from err
+
+    def fits(self, width: int, height: int) -> bool:
+        return width <= self.width and height <= self.height
+
+    def make_current(self) -> None:
+        if self._gl is None:
+            raise RuntimeError("render context used after close")
+        self._gl.make_current()
+
+    def close(self) -> None:
+        if self._gl is not None:
+            self._gl.free()
+            self._gl = None
+
+    def __enter__(self) -> RenderContext:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.close()
+
+
+class SceneRenderer:
+    """Renders the robot camera of a Scene at the camera model's image size.
+
+    `context`, when given, is borrowed (and stays open after close); otherwise the
+    renderer makes its own.
+    """
+
+    def __init__(
+        self, scene: Scene, max_geom: int = 2000, context: RenderContext | None = None
+    ) -> None:
         self.scene = scene
         cam = scene.camera
         self.width, self.height = cam.width, cam.height
         model = scene.model
+        if context is not None and not context.fits(self.width, self.height):
+            raise ValueError(
+                f"a {context.width}x{context.height} render context cannot hold "
+                f"{self.width}x{self.height} images"
+            )
+        self._own_context = context is None
+        self._context = context or RenderContext(self.width, self.height)
         try:
-            self._context = _gl_context(self.width, self.height)
             self._context.make_current()
             self._mjr = mujoco.MjrContext(model, mujoco.mjtFontScale.mjFONTSCALE_100)
-        except Exception as err:  # ImportError, OSError, RuntimeError, mujoco.FatalError
-            backend = os.environ.get("MUJOCO_GL", "egl")
-            raise GLUnavailableError(
-                f"cannot create an offscreen OpenGL context (MUJOCO_GL={backend!r}): {err}. "
-                f"Install the EGL/Mesa packages: apt-get install {' '.join(GL_PACKAGES)}"
-            ) from err
+        except Exception as err:  # RuntimeError, mujoco.FatalError
+            if self._own_context:
+                self._context.close()
+            raise _unavailable(err) from err
         mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._mjr)
         self._scene = mujoco.MjvScene(model, maxgeom=max_geom)
         self._rect = mujoco.MjrRect(0, 0, self.width, self.height)
@@ -133,7 +192,8 @@ class SceneRenderer:
         if self._mjr is not None:
             self._mjr.free()
             self._mjr = None
-            self._context.free()
+            if self._own_context:
+                self._context.close()
 
     def __enter__(self) -> SceneRenderer:
         return self

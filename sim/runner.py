@@ -32,6 +32,7 @@ from monopic.predictors import make_predictor
 from monopic.variants.warning import CollisionWarning
 from monopic.variants.zone import RobotGeometry
 from sim.ground_truth import GroundTruth
+from sim.render import RenderContext
 from sim.scenario import Scenario
 from sim.world import World
 
@@ -259,8 +260,15 @@ def machine() -> dict[str, Any]:
     return {"host": platform.node(), "cpu": cpu, "cores": os.cpu_count()}
 
 
-def run(spec: RunSpec, on_frame: Callable[[int], None] | None = None) -> dict[str, Any]:
-    """Run one scenario through the pipeline(s); returns its result line (a dict)."""
+def run(
+    spec: RunSpec,
+    on_frame: Callable[[int], None] | None = None,
+    render_context: RenderContext | None = None,
+) -> dict[str, Any]:
+    """Run one scenario through the pipeline(s); returns its result line (a dict).
+
+    A worker running many scenarios lends each the same `render_context` (sim.render).
+    """
     scenario = spec.scenario
     start = time.perf_counter()
     main = make_pipeline(scenario)
@@ -270,7 +278,7 @@ def run(spec: RunSpec, on_frame: Callable[[int], None] | None = None) -> dict[st
     sim_ms: list[float] = []
     contact_time = None
     recording_path = None
-    with World(scenario, render=True) as world:
+    with World(scenario, render=True, render_context=render_context) as world:
         recording = _start_recording(spec, world)
         t0 = time.perf_counter()
         step = world.reset()

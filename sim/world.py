@@ -40,7 +40,7 @@ from sim.ground_truth import (
     time_to_contact,
 )
 from sim.pedestrian import PathState, Pedestrian
-from sim.render import Marker, SceneRenderer
+from sim.render import Marker, RenderContext, SceneRenderer
 from sim.robot import Robot, highway_road
 from sim.scenario import Scenario
 from sim.scene import Scene, SceneConfig
@@ -67,12 +67,19 @@ class World:
     """A scenario brought to life; call reset() first, then step() once per frame."""
 
     def __init__(
-        self, scenario: Scenario, render: bool = True, ttc_lookahead: float = TTC_LOOKAHEAD
+        self,
+        scenario: Scenario,
+        render: bool = True,
+        ttc_lookahead: float = TTC_LOOKAHEAD,
+        render_context: RenderContext | None = None,
     ) -> None:
+        """`render_context`, when given, is lent to the renderer (sim.render: reusing one
+        across worlds saves its shader compilation); otherwise the world makes its own."""
         if not ttc_lookahead >= scenario.horizon:
             raise ValueError("the time-to-collision lookahead must cover the horizon")
         self.scenario = scenario
         self.render_frames = render
+        self.render_context = render_context
         self.ttc_lookahead = ttc_lookahead
         self.camera: CameraModel = scenario.robot.camera.model()
         scene_spec = scenario.scene
@@ -147,13 +154,13 @@ class World:
     def render(self, markers: tuple[Marker, ...] = ()) -> np.ndarray:
         """The robot camera's image of the current state (RGB uint8), e.g. with test markers."""
         if self._renderer is None:
-            self._renderer = SceneRenderer(self.scene)
+            self._renderer = SceneRenderer(self.scene, context=self.render_context)
         return self._renderer.render(markers)
 
     def pedestrian_mask(self) -> np.ndarray:
         """Pixels where the pedestrian is visible in the current image (bool, H x W)."""
         if self._renderer is None:
-            self._renderer = SceneRenderer(self.scene)
+            self._renderer = SceneRenderer(self.scene, context=self.render_context)
         return self._renderer.pedestrian_mask()
 
     def close(self) -> None:

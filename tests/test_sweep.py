@@ -10,7 +10,7 @@ import pytest
 
 from monopic.cli.main import main
 from monopic.errors import UserError
-from sim.executors import local_executor, ray_executor, ray_runtime_env
+from sim.executors import WorkerState, local_executor, ray_executor, ray_runtime_env, work
 from sim.results_file import ResultsWriter, read_rows, scan
 from sim.runner import deterministic_part
 from sim.sweep import expand_spec, load_spec, run_sweep
@@ -79,6 +79,24 @@ def test_results_file_ignores_a_torn_tail_and_rejects_a_bad_middle(tmp_path: Pat
     path.write_bytes(b'{"id": "a"}\nnot json\n{"id": "b"}\n')
     with pytest.raises(UserError, match=r"r.jsonl:2: not a result line"):
         scan(path)
+
+
+@pytest.mark.slow
+def test_a_worker_keeps_one_render_context_for_its_runs(spec_path: Path) -> None:
+    specs = expand_spec(load_spec(spec_path))
+    state = WorkerState()
+    try:
+        rows = [work(spec, state) for spec in specs[:2]]
+        kept = state.render
+        assert kept is not None and state.render_context(specs[2]) is kept
+    finally:
+        state.close()
+    assert state.render is None
+    assert [r["id"] for r in rows] == [s.id for s in specs[:2]]
+    assert not any("error" in r for r in rows)
+    # The same results as runs with their own context.
+    fresh = [work(spec) for spec in specs[:2]]
+    assert [deterministic_part(r) for r in rows] == [deterministic_part(r) for r in fresh]
 
 
 @pytest.mark.slow

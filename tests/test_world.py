@@ -22,7 +22,7 @@ from sim.ground_truth import contact_window
 from sim.highway_frame import highway_to_world, reflect, world_to_highway
 from sim.mannequin import MannequinSpec
 from sim.pedestrian import PedestrianPath
-from sim.render import Marker
+from sim.render import Marker, RenderContext
 from sim.road import Occluder, RoadLayout
 from sim.robot import Robot, highway_road
 from sim.scenario import CameraSpec, Leg, PedestrianSpec, RobotSpec, Scenario, SceneSpec
@@ -133,6 +133,31 @@ def test_marker_lands_on_the_camera_model_projection_with_a_moving_robot() -> No
             expected = camera.project(p)
             found = marker_centroid(image)
             assert np.linalg.norm(found - expected) < 1.0, (p, found, expected)
+
+
+
+def test_a_borrowed_render_context_renders_as_a_fresh_one_and_outlives_its_worlds() -> None:
+    """Worlds one after another on one RenderContext (as a sweep worker runs them) draw the
+    same images as worlds with their own, and leave the context open for the next."""
+    first = place_case(Case.PERPENDICULAR_RIGHT, distance=8.0)
+    second = place_case(Case.OBLIQUE_LEFT_AWAY, distance=6.0)
+
+    def frames(sc: Scenario, context: RenderContext | None) -> list[np.ndarray]:
+        with World(sc, render_context=context) as world:
+            steps = [world.reset()] + [world.step() for _ in range(3)]
+        return [s.frame.image for s in steps]
+
+    with RenderContext(768, 432) as shared:
+        borrowed = frames(first, shared) + frames(second, shared)
+        assert shared.fits(768, 432)
+        shared.make_current()  # still open after both worlds closed
+    own = frames(first, None) + frames(second, None)
+    for a, b in zip(borrowed, own, strict=True):
+        np.testing.assert_array_equal(a, b)
+    with pytest.raises(RuntimeError, match="after close"):
+        shared.make_current()
+    with RenderContext(320, 240) as small, pytest.raises(ValueError, match="cannot hold"):
+        frames(first, small)
 
 
 # -- robot and pedestrian --------------------------------------------------------------
