@@ -17,12 +17,12 @@ import os
 os.environ.setdefault("MUJOCO_GL", "egl")
 
 from dataclasses import dataclass  # noqa: E402
-from types import TracebackType  # noqa: E402
 from typing import Any  # noqa: E402
 
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
+from sim.closing import Closing  # noqa: E402
 from sim.scene import Scene  # noqa: E402
 
 GLContext = Any  # mujoco's egl/osmesa/glfw GLContext classes share no base class
@@ -68,7 +68,7 @@ def _unavailable(err: Exception) -> GLUnavailableError:
     )
 
 
-class RenderContext:
+class RenderContext(Closing):
     """An offscreen OpenGL context that renderers can use one after another.
 
     Images up to width x height; renderers given one borrow it and leave it open.
@@ -94,19 +94,8 @@ class RenderContext:
             self._gl.free()
             self._gl = None
 
-    def __enter__(self) -> RenderContext:
-        return self
 
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
-
-
-class SceneRenderer:
+class SceneRenderer(Closing):
     """Renders the robot camera of a Scene at the camera model's image size.
 
     `context`, when given, is borrowed (and stays open after close); otherwise the
@@ -194,17 +183,6 @@ class SceneRenderer:
             self._mjr = None
             if self._own_context:
                 self._context.close()
-
-    def __enter__(self) -> SceneRenderer:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
 
 
 def _add_marker(scene: mujoco.MjvScene, marker: Marker) -> None:

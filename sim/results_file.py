@@ -14,10 +14,10 @@ import os
 from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
-from types import TracebackType
 from typing import Any
 
 from monopic.errors import UserError
+from sim.closing import Closing
 
 
 @dataclass(frozen=True)
@@ -66,7 +66,7 @@ def read_rows(path: Path) -> Iterator[dict[str, Any]]:
             yield json.loads(raw)
 
 
-class ResultsWriter:
+class ResultsWriter(Closing):
     """Appends result lines durably, one writer per file (a lock), torn tail cut off first.
 
     The lock keeps two sweeps from appending to the same file at once (each would run
@@ -95,14 +95,3 @@ class ResultsWriter:
 
     def close(self) -> None:
         self._fh.close()
-
-    def __enter__(self) -> ResultsWriter:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()

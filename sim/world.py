@@ -19,13 +19,13 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from types import TracebackType
 
 import numpy as np
 from highway_env.road.road import Road
 
 from monopic.camera import CameraModel
 from monopic.frame import EgoState, Frame
+from sim.closing import Closing
 from sim.frames import Pose2D, wrap_angle
 from sim.ground_truth import (
     CASE_WINDOW,
@@ -63,7 +63,7 @@ class WorldStep:
     frame: Frame | None
 
 
-class World:
+class World(Closing):
     """A scenario brought to life; call reset() first, then step() once per frame."""
 
     def __init__(
@@ -167,17 +167,6 @@ class World:
         if self._renderer is not None:
             self._renderer.close()
             self._renderer = None
-
-    def __enter__(self) -> World:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.close()
 
     # -- truth ------------------------------------------------------------------------
 
