@@ -61,7 +61,8 @@ class Pose:
 
 class LandmarkModel:
     def __init__(self, threads: int = 1) -> None:
-        self.session = make_session(model_path(LANDMARK_FILE), threads)
+        # The one model of every tracked frame: its threads may spin (sessions.py).
+        self.session = make_session(model_path(LANDMARK_FILE), threads, spin=True)
         self.input_name = self.session.get_inputs()[0].name
         # Outputs are told apart by shape: landmarks (1, 195), pose flag (1, 1), heatmap
         # (1, 64, 64, 39).

@@ -1,8 +1,7 @@
 """onnxruntime sessions with an explicit thread budget.
 
 Parallel sweep workers each run their own pipeline; sessions that spin-wait or take every
-core would fight, so the thread count is always explicit; one thread (what sweep workers use)
-never spins.
+core would fight, so the thread count is always explicit (sweep workers use one).
 """
 
 from __future__ import annotations
@@ -26,8 +25,16 @@ def model_path(name: str) -> Path:
     return path
 
 
-def make_session(path: Path, threads: int = 1) -> ort.InferenceSession:
-    """A CPU session using exactly `threads` intra-op threads."""
+def make_session(path: Path, threads: int = 1, spin: bool = False) -> ort.InferenceSession:
+    """A CPU session using exactly `threads` intra-op threads.
+
+    `spin` lets a multi-threaded session's idle threads spin-wait between runs: for the
+    model that runs every frame on its own (the landmark model), where waking sleeping
+    threads cost 7 % and the occasional 30 % on this VM (2 threads, 7.8 vs 8.3 ms per
+    frame). Not for two sessions that take turns: each one's spinning threads then hold
+    the cores the other needs (the detector ran 2x slower right after a spinning
+    landmark session). One thread has no pool: nothing spins.
+    """
     if threads < 1:
         raise ValueError(f"threads must be >= 1, got {threads}")
     opts = ort.SessionOptions()
@@ -35,11 +42,9 @@ def make_session(path: Path, threads: int = 1) -> ort.InferenceSession:
     opts.inter_op_num_threads = 1
     opts.execution_mode = ort.ExecutionMode.ORT_SEQUENTIAL
     opts.graph_optimization_level = ort.GraphOptimizationLevel.ORT_ENABLE_ALL
-    # One thread: no pool, nothing to spin. Several threads serve one pipeline's latency
-    # (sweep workers always use one): short spins before each parallel section, and
-    # dynamic blocks that let a thread the VM delayed catch up (bench/compare_reference.py).
-    opts.add_session_config_entry("session.intra_op.allow_spinning", "1" if threads > 1 else "0")
-    if threads > 1:
+    spinning = "1" if spin and threads > 1 else "0"
+    opts.add_session_config_entry("session.intra_op.allow_spinning", spinning)
+    if threads > 1:  # smaller blocks, taken dynamically: a delayed thread does less
         opts.add_session_config_entry("session.dynamic_block_base", "4")
     opts.add_session_config_entry("session.inter_op.allow_spinning", "0")
     return ort.InferenceSession(str(path), sess_options=opts, providers=["CPUExecutionProvider"])
