@@ -155,6 +155,6 @@ def test_a_model_without_a_heatmap_output_is_refused(monkeypatch: pytest.MonkeyP
     import monopic.pose.landmarks as landmarks
 
     real = landmarks.make_session
-    monkeypatch.setattr(landmarks, "make_session", lambda *a: NoHeatmap(real(*a)))
+    monkeypatch.setattr(landmarks, "make_session", lambda *a, **kw: NoHeatmap(real(*a, **kw)))
     with pytest.raises(ValueError, match="heatmap"):
         LandmarkModel()
