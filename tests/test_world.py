@@ -135,7 +135,6 @@ def test_marker_lands_on_the_camera_model_projection_with_a_moving_robot() -> No
             assert np.linalg.norm(found - expected) < 1.0, (p, found, expected)
 
 
-
 def test_a_borrowed_render_context_renders_as_a_fresh_one_and_outlives_its_worlds() -> None:
     """Worlds one after another on one RenderContext (as a sweep worker runs them) draw the
     same images as worlds with their own, and leave the context open for the next."""
