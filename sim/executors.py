@@ -62,7 +62,7 @@ class WorkerState:
 
 
 def work(spec: RunSpec, state: WorkerState | None = None) -> dict[str, Any]:
-    """One run in a worker; a failure comes back as {"id", "error"} instead of killing the pool."""
+    """One run in a worker; a failure comes back as {"id", "error"} instead of ending the sweep."""
     from sim.runner import run
 
     try:
