@@ -6,7 +6,7 @@ from sim.runner): render time per frame at 768x432 (World.step with and without
 rendering), frames per second of a whole scenario run (sim.runner.run: render +
 pipeline with all five predictors + bookkeeping) pinned to one core with and without
 the ground-truth-crop ablation pipeline, and sweep throughput through sim.executors'
-spawn pool with 1 and 2 workers, with the peak RSS of a worker (ru_maxrss of the
+spawned workers (1 and 2), with the peak RSS of a worker (ru_maxrss of the
 reaped children).
 
     .venv/bin/python bench/simulator.py [--frames 60] [--runs 6] [--no-append]
