@@ -55,10 +55,6 @@ class LowPassFilter:
     _raw: np.ndarray | None = field(default=None, init=False, repr=False)
 
     @property
-    def initialised(self) -> bool:
-        return self._stored is not None
-
-    @property
     def last_raw(self) -> np.ndarray | None:
         return self._raw
 

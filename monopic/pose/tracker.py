@@ -113,6 +113,7 @@ class PoseTracker:
             self._filter.reset()
         for attempt in range(2):
             if self._region is None:
+                self._filter.reset()  # a new track: MediaPipe's filters restart with it
                 t0 = time.perf_counter()
                 self._region, runs_now = self._acquire(image, band)
                 runs += runs_now
@@ -129,10 +130,8 @@ class PoseTracker:
                 self._region = next_region if next_region.valid else None
                 return PoseResult(pose, runs, detect_ms, landmark_ms)
             self._region = None
-            self._filter.reset()  # lost: MediaPipe's filters reset on a frame without pose
             if attempt == 0 and runs > 0:
                 break  # fresh detection already failed the landmark check
-        self._filter.reset()
         return PoseResult(None, runs, detect_ms, landmark_ms)
 
     def _acquire(self, image: np.ndarray, band: GroundBand | None) -> tuple[Region | None, int]:
