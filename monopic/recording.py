@@ -29,13 +29,13 @@ from __future__ import annotations
 
 import os
 from pathlib import Path
-from types import TracebackType
 
 import cv2
 import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from monopic.closing import WholeOrNothing
 from monopic.output import temporary_sibling
 from monopic.pipeline import FrameResult
 from monopic.pose.skeleton import CONNECTIONS, LANDMARK_NAMES
@@ -131,7 +131,7 @@ def encoded_jpeg(image: np.ndarray, quality: int = JPEG_QUALITY) -> rr.EncodedIm
     return rr.EncodedImage(contents=jpeg.tobytes(), media_type="image/jpeg")
 
 
-class RunRecording:
+class RunRecording(WholeOrNothing):
     """Writes one run to a .rrd file."""
 
     def __init__(
@@ -267,18 +267,3 @@ class RunRecording:
         """Drop the partial recording."""
         self.rec.disconnect()
         self.tmp.unlink(missing_ok=True)
-
-    def __enter__(self) -> RunRecording:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        """Whole or nothing: the file appears only when the run ended without an error."""
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()

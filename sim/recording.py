@@ -42,12 +42,13 @@ import os
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from types import SimpleNamespace, TracebackType
+from types import SimpleNamespace
 
 import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
+from monopic.closing import WholeOrNothing
 from monopic.pipeline import FrameResult, Pipeline
 from monopic.pose.skeleton import CONNECTIONS, LANDMARK_NAMES
 from monopic.predict.base import Mode
@@ -329,7 +330,7 @@ class RecordSummary:
     primary: str = ""  # the pipeline's primary predictor (its warning is the robot's)
 
 
-class SimRecording:
+class SimRecording(WholeOrNothing):
     """One scenario run written to .rrd, frame by frame.
 
     Call `log_step(step, result)` right after each World step (result: the pipeline's
@@ -816,20 +817,6 @@ class SimRecording:
         if self._topdown is not None:
             self._topdown.close()
             self._topdown = None
-
-    def __enter__(self) -> SimRecording:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        if exc_type is None:
-            self.close()
-        else:
-            self.abort()
 
 
 def record_run(

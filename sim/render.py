@@ -22,7 +22,7 @@ from typing import Any  # noqa: E402
 import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
-from sim.closing import Closing  # noqa: E402
+from monopic.closing import Closing  # noqa: E402
 from sim.scene import Scene  # noqa: E402
 
 GLContext = Any  # mujoco's egl/osmesa/glfw GLContext classes share no base class

@@ -16,8 +16,8 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from monopic.closing import Closing
 from monopic.errors import UserError
-from sim.closing import Closing
 
 
 @dataclass(frozen=True)

@@ -24,8 +24,8 @@ import numpy as np
 from highway_env.road.road import Road
 
 from monopic.camera import CameraModel
+from monopic.closing import Closing
 from monopic.frame import EgoState, Frame
-from sim.closing import Closing
 from sim.frames import Pose2D, wrap_angle
 from sim.ground_truth import (
     CASE_WINDOW,
