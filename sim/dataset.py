@@ -62,6 +62,7 @@ from monopic.predict.rules import RulePredictor
 from sim.cases import OBLIQUE_RANGE_DEG, place_case
 from sim.coco import SKELETONS, category, encode_mask, mask_box, select_keypoints
 from sim.ground_truth import GroundTruth
+from sim.render import KeptRenderContext
 from sim.scenario import CameraSpec, RobotSpec, Scenario
 from sim.scenario_file import Values
 from sim.sweep import SPEC_KEYS as SWEEP_KEYS
@@ -364,9 +365,15 @@ def _plain(value: object) -> object:
 
 
 def render_run(
-    run: DatasetRun, out: Path, on_frame: Callable[[int], None] | None = None
+    run: DatasetRun,
+    out: Path,
+    on_frame: Callable[[int], None] | None = None,
+    kept: KeptRenderContext | None = None,
 ) -> dict[str, Any]:
-    """Render one run into `out`; returns (and writes last) its runs/<id>.json record."""
+    """Render one run into `out`; returns (and writes last) its runs/<id>.json record.
+
+    `kept`: a GL context lent from run to run (sim.render), else the run makes its own.
+    """
     scenario = run.scenario
     cam = scenario.robot.camera
     for sub in ("images", "masks"):
@@ -379,7 +386,8 @@ def render_run(
     truth_lines, feature_rows = [], []
     contact_time = None
     found = 0
-    with World(scenario, render=True) as world:
+    context = kept.fitting(cam.width, cam.height) if kept is not None else None
+    with World(scenario, render=True, render_context=context) as world:
         step = world.reset()
         for k in range(scenario.frames):
             if k > 0:
@@ -586,11 +594,12 @@ def build(
     report(f"size: {size.text()}")
     report(f"{len(done)} of {len(runs)} runs already finished, {len(todo)} to render")
     on_frame = progress(sum(r.scenario.frames for r in todo)) if progress and todo else None
-    for run in todo:
-        done[run.id] = render_run(run, out, on_frame)
-        if not size.measured:
-            size = estimate(runs, list(done.values()))
-            report(f"size, measured on the first run: {size.text()}")
+    with KeptRenderContext() as kept:
+        for run in todo:
+            done[run.id] = render_run(run, out, on_frame, kept)
+            if not size.measured:
+                size = estimate(runs, list(done.values()))
+                report(f"size, measured on the first run: {size.text()}")
     return merge(spec, out, [done[r.id] for r in runs])
 
 

@@ -4,8 +4,8 @@ Both call the same `work(spec)` and hand each finished result to the sweep as it
 arrives; results depend only on the RunSpec (its seed included), never on the executor.
 Workers render with their own EGL context (created in the worker: contexts do not
 survive fork, hence spawn) and run onnxruntime with one thread, so N workers use N cores.
-A local worker keeps its GL context from run to run (sim.render.RenderContext: a fresh
-one costs about 0.2 s of shader compilation per run on llvmpipe).
+A local worker keeps its GL context from run to run (sim.render.KeptRenderContext: a
+fresh one costs about 0.2 s of shader compilation per run on llvmpipe).
 """
 
 from __future__ import annotations
@@ -17,17 +17,14 @@ import queue
 import signal
 import traceback
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
 from multiprocessing.process import BaseProcess
 from multiprocessing.queues import Queue
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import Any
 
 from monopic.errors import UserError
+from sim.render import KeptRenderContext
 from sim.runner import RunSpec
-
-if TYPE_CHECKING:
-    from sim.render import RenderContext
 
 # What every worker's environment needs before it imports MuJoCo or numpy.
 WORKER_ENV = {
@@ -40,33 +37,16 @@ WORKER_ENV = {
 RAY_PIN = "2.60.0"
 
 
-@dataclass
-class WorkerState:
-    """What a local worker keeps between runs: a GL context big enough for the images."""
+def work(spec: RunSpec, kept: KeptRenderContext | None = None) -> dict[str, Any]:
+    """One run in a worker; a failure comes back as {"id", "error"} instead of ending the sweep.
 
-    render: RenderContext | None = None
-
-    def render_context(self, spec: RunSpec) -> RenderContext:
-        from sim.render import RenderContext
-
-        camera = spec.scenario.robot.camera.model()
-        if self.render is None or not self.render.fits(camera.width, camera.height):
-            self.close()
-            self.render = RenderContext(camera.width, camera.height)
-        return self.render
-
-    def close(self) -> None:
-        if self.render is not None:
-            self.render.close()
-            self.render = None
-
-
-def work(spec: RunSpec, state: WorkerState | None = None) -> dict[str, Any]:
-    """One run in a worker; a failure comes back as {"id", "error"} instead of ending the sweep."""
+    `kept`: the worker's GL context, lent to the run.
+    """
     from sim.runner import run
 
     try:
-        context = state.render_context(spec) if state is not None else None
+        camera = spec.scenario.robot.camera
+        context = kept.fitting(camera.width, camera.height) if kept is not None else None
         return run(spec, render_context=context)
     except Exception:  # noqa: BLE001 - reported per run; the sweep goes on
         return {"id": spec.id, "error": traceback.format_exc()}
@@ -75,12 +55,9 @@ def work(spec: RunSpec, state: WorkerState | None = None) -> dict[str, Any]:
 def _worker(tasks: Queue, results: Queue) -> None:
     """A local worker process: runs specs from `tasks` until None; Ctrl-C is the parent's."""
     signal.signal(signal.SIGINT, signal.SIG_IGN)
-    state = WorkerState()
-    try:
+    with KeptRenderContext() as kept:
         for spec in iter(tasks.get, None):
-            results.put(work(spec, state))
-    finally:
-        state.close()
+            results.put(work(spec, kept))
 
 
 @contextlib.contextmanager

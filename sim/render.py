@@ -95,6 +95,25 @@ class RenderContext(Closing):
             self._gl = None
 
 
+class KeptRenderContext(Closing):
+    """One RenderContext lent to world after world (a sweep worker's runs, a dataset's),
+    made again only when an image outgrows it."""
+
+    def __init__(self) -> None:
+        self.context: RenderContext | None = None
+
+    def fitting(self, width: int, height: int) -> RenderContext:
+        if self.context is None or not self.context.fits(width, height):
+            self.close()
+            self.context = RenderContext(width, height)
+        return self.context
+
+    def close(self) -> None:
+        if self.context is not None:
+            self.context.close()
+            self.context = None
+
+
 class SceneRenderer(Closing):
     """Renders the robot camera of a Scene at the camera model's image size.
 

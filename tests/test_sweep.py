@@ -10,7 +10,8 @@ import pytest
 
 from monopic.cli.main import main
 from monopic.errors import UserError
-from sim.executors import WorkerState, local_executor, ray_executor, ray_runtime_env, work
+from sim.executors import local_executor, ray_executor, ray_runtime_env, work
+from sim.render import KeptRenderContext
 from sim.results_file import ResultsWriter, read_rows, scan
 from sim.runner import deterministic_part
 from sim.sweep import expand_spec, load_spec, run_sweep
@@ -84,14 +85,15 @@ def test_results_file_ignores_a_torn_tail_and_rejects_a_bad_middle(tmp_path: Pat
 @pytest.mark.slow
 def test_a_worker_keeps_one_render_context_for_its_runs(spec_path: Path) -> None:
     specs = expand_spec(load_spec(spec_path))
-    state = WorkerState()
+    kept = KeptRenderContext()
     try:
-        rows = [work(spec, state) for spec in specs[:2]]
-        kept = state.render
-        assert kept is not None and state.render_context(specs[2]) is kept
+        rows = [work(spec, kept) for spec in specs[:2]]
+        context = kept.context
+        camera = specs[2].scenario.robot.camera
+        assert context is not None and kept.fitting(camera.width, camera.height) is context
     finally:
-        state.close()
-    assert state.render is None
+        kept.close()
+    assert kept.context is None
     assert [r["id"] for r in rows] == [s.id for s in specs[:2]]
     assert not any("error" in r for r in rows)
     # The same results as runs with their own context.
