@@ -77,15 +77,16 @@ def child_render(frames: int) -> dict[str, Any]:
 def child_run(frames: int, ablation: bool, shadows: bool = True) -> dict[str, Any]:
     """One whole scenario through sim.runner.run, after one warm-up run; frames per second.
 
-    As in a sweep worker, the runs share one GL context (sim.executors.WorkerState), so
+    As in a sweep worker, the runs share one GL context (sim.render.KeptRenderContext), so
     llvmpipe's shader compilation is paid once by the warm-up, not by every run.
     """
-    from sim.render import RenderContext
+    from sim.render import KeptRenderContext
     from sim.runner import RunSpec, run
 
     warm = RunSpec(id="warm", scenario=scenario(1, 10), ablation=ablation, stop_at_contact=False)
     results = []
-    with RenderContext(768, 432) as context:
+    with KeptRenderContext() as kept:
+        context = kept.fitting(768, 432)
         run(warm, render_context=context)
         for case in RUN_CASES:
             spec = RunSpec(
