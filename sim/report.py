@@ -20,6 +20,7 @@ from sim.metrics import (
     LEAD_GOAL,
     MAIN,
     TIMELY_TTC,
+    CaseSummary,
     SweepMetrics,
     WarningSummary,
     split_method,
@@ -32,6 +33,12 @@ def pct(value: float) -> str:
 
 def num(value: float, digits: int = 2) -> str:
     return "-" if math.isnan(value) else f"{value:.{digits}f}"
+
+
+def said(cases: CaseSummary) -> str:
+    """'7 toward (94 %)': the case a method answers most, with its share."""
+    most = cases.most_predicted
+    return "-" if most is None else f"{int(most[0])} {most[0].label} ({pct(most[1])})"
 
 
 def table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
@@ -258,7 +265,9 @@ def write_report(m: SweepMetrics, rows: Sequence[dict], results: Path, out_dir: 
         "## Cases, facing angle, positions",
         "",
         "Case accuracy against the ground-truth case of the next second of motion; confusion",
-        "matrices are row-normalised (rows: true case).",
+        "matrices are row-normalised (rows: true case). 'Most often said' is the case a",
+        "method answers most and its share of its decisions: a method that gives one answer",
+        "whatever the truth scores low accuracy however well it places the point.",
         "",
         "![confusion](confusion.png)",
         "",
@@ -267,6 +276,7 @@ def write_report(m: SweepMetrics, rows: Sequence[dict], results: Path, out_dir: 
                 "method",
                 "decided frames",
                 "case acc.",
+                "most often said",
                 "px err p50",
                 "px err p90",
                 "m err p50",
@@ -277,6 +287,7 @@ def write_report(m: SweepMetrics, rows: Sequence[dict], results: Path, out_dir: 
                     x,
                     str(m.cases[x].frames),
                     pct(m.cases[x].accuracy),
+                    said(m.cases[x]),
                     num(m.positions[x].px_percentile(50), 0),
                     num(m.positions[x].px_percentile(90), 0),
                     num(m.positions[x].m_percentile(50)),

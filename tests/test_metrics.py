@@ -8,6 +8,7 @@ from typing import Any
 
 import pytest
 
+from monopic.cases import Case
 from sim.metrics import (
     available_times,
     case_summary,
@@ -179,6 +180,8 @@ def test_case_accuracy_confusion_and_position_error() -> None:
     cases = case_summary([r], KEY)
     assert cases.frames == 10 and cases.accuracy == pytest.approx(0.6)
     assert cases.confusion[4, 4] == 6 and cases.confusion[4, 5] == 4
+    assert cases.most_predicted == (Case.PERPENDICULAR_RIGHT, pytest.approx(0.6))
+    assert case_summary([row("b", [None] * 2, [None] * 2)], KEY).most_predicted is None
     positions = position_summary([r], KEY)
     # Horizon 0.5 s = 5 frames: frames 0-6 have a true foot 5 frames later; error (3, 4).
     assert len(positions.px) == 7 and positions.px_percentile(50) == pytest.approx(5.0)
