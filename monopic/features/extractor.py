@@ -7,6 +7,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from monopic.features.ground import GroundMotion
+from monopic.features.ground_track import GroundTrackConfig
 from monopic.features.motion import VelocityEstimator
 from monopic.features.orientation import facing_angle
 from monopic.features.smoothing import Kalman1D
@@ -38,8 +39,9 @@ def foot_point(pose: Pose, image_height: int) -> tuple[float, float]:
 class FeatureExtractor:
     """Stateful per-track feature computation; reset it when the track is lost for long."""
 
-    velocity_window: int = 4
+    velocity_window: int = 4  # image velocity, as the authors compute it
     velocity_average: int = 4
+    ground_track: GroundTrackConfig = field(default_factory=GroundTrackConfig)
     max_gap: float = 0.5  # seconds without a pose before the track's history is dropped
     phi_filter: Kalman1D = field(default_factory=Kalman1D)
     _image_velocity: VelocityEstimator = field(init=False)
@@ -48,7 +50,7 @@ class FeatureExtractor:
 
     def __post_init__(self) -> None:
         self._image_velocity = VelocityEstimator(self.velocity_window, self.velocity_average)
-        self._ground = GroundMotion(self.velocity_window, self.velocity_average)
+        self._ground = GroundMotion(self.ground_track)
 
     def update(
         self, timestamp: float, pose: Pose | None, image_height: int, ego: EgoState | None = None
@@ -72,7 +74,7 @@ class FeatureExtractor:
         vx, vy = self._image_velocity.update(timestamp, *center)
         ground = None
         if ego is not None:
-            g = self._ground.update(timestamp, ego, foot)
+            g = self._ground.update(timestamp, ego, foot, pose.height)
             if g is not None:
                 ground = GroundFeatures(position=g[0], velocity=g[1], camera=ego.camera)
         return Features(

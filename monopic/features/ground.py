@@ -1,8 +1,9 @@
 """Ground-plane motion in the robot's frame with the robot's own motion taken out.
 
 A moving camera makes a standing pedestrian appear to approach. The robot knows its own
-speed and yaw rate, so it integrates them into an odometry pose, stores the pedestrian's
-foot point in that fixed odometry frame, differentiates there, and rotates the velocity
+speed and yaw rate, so it integrates them into an odometry pose, tracks the pedestrian's
+foot point in that fixed odometry frame (a Kalman filter, `ground_track`, fed each foot
+point with its pixel noise carried onto the ground), and rotates position and velocity
 back into its current frame. The result is the pedestrian's own ground velocity.
 """
 
@@ -13,7 +14,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monopic.features.motion import VelocityEstimator
+from monopic.features.ground_track import GroundTrack, GroundTrackConfig
 from monopic.frame import EgoState
 
 
@@ -43,36 +44,75 @@ class Odometry:
         c, s = math.cos(self.yaw), math.sin(self.yaw)
         return (c * v[0] + s * v[1], -s * v[0] + c * v[1])
 
+    def to_robot(self, p: tuple[float, float]) -> tuple[float, float]:
+        """A fixed-frame point in the robot's current frame (inverse of `to_fixed`)."""
+        return self.rotate_to_robot((p[0] - self.x, p[1] - self.y))
+
+    def rotation(self) -> np.ndarray:
+        """Robot-frame vectors to fixed-frame vectors."""
+        c, s = math.cos(self.yaw), math.sin(self.yaw)
+        return np.array([[c, -s], [s, c]])
+
 
 @dataclass
 class GroundMotion:
-    """Own ground velocity of a tracked foot point, from frames of a moving robot."""
+    """Own ground position and velocity of a tracked foot point, from a moving robot."""
 
-    window: int = 4
-    average: int = 4
+    config: GroundTrackConfig = field(default_factory=GroundTrackConfig)
     odometry: Odometry = field(default_factory=Odometry)
-    _velocity: VelocityEstimator = field(init=False)
+    _track: GroundTrack = field(init=False)
 
     def __post_init__(self) -> None:
-        self._velocity = VelocityEstimator(self.window, self.average)
+        self._track = GroundTrack(self.config)
 
     def observe_ego(self, t: float, ego: EgoState) -> None:
         """Advance odometry; call on every frame, with or without a pedestrian."""
         self.odometry.update(t, ego)
 
     def update(
-        self, t: float, ego: EgoState, foot_px: tuple[float, float]
+        self, t: float, ego: EgoState, foot_px: tuple[float, float], apparent_height: float = 0.0
     ) -> tuple[tuple[float, float], tuple[float, float]] | None:
-        """(position, own velocity) in the robot's current frame, or None above the horizon."""
-        g = ego.camera.ground_point(np.array(foot_px, dtype=float))
-        if not np.all(np.isfinite(g)):
+        """(position, own velocity) in the robot's current frame, or None above the horizon.
+
+        `apparent_height` (px) sets the foot point's pixel noise: a big, near person's
+        landmarks jitter by more pixels than a small, far one's.
+        """
+        measured = foot_on_ground(
+            ego, foot_px, self._pixel_noise(apparent_height), self.config.min_position_noise
+        )
+        if measured is None:
             return None
-        pos = (float(g[0]), float(g[1]))
-        fx, fy = self.odometry.to_fixed(pos)
-        vx, vy = self._velocity.update(t, fx, fy)
-        if not (math.isfinite(vx) and math.isfinite(vy)):
-            return pos, (float("nan"), float("nan"))
-        return pos, self.odometry.rotate_to_robot((vx, vy))
+        g, cov = measured
+        rot = self.odometry.rotation()
+        z = np.array(self.odometry.to_fixed((float(g[0]), float(g[1]))))
+        self._track.update(t, z, rot @ cov @ rot.T)
+        p, v = self._track.position, self._track.velocity
+        position = self.odometry.to_robot((float(p[0]), float(p[1])))
+        return position, self.odometry.rotate_to_robot((float(v[0]), float(v[1])))
 
     def reset_track(self) -> None:
-        self._velocity.reset()
+        self._track.reset()
+
+    def _pixel_noise(self, apparent_height: float) -> float:
+        h = apparent_height if math.isfinite(apparent_height) and apparent_height > 0 else 0.0
+        return self.config.pixel_noise + self.config.pixel_noise_per_height * h
+
+
+def foot_on_ground(
+    ego: EgoState, foot_px: tuple[float, float], pixel_noise: float, min_noise: float = 0.05
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """The ground point under a foot pixel and its covariance (robot frame, m and m^2).
+
+    The covariance is the isotropic pixel noise carried through the ground projection
+    (its Jacobian by central differences), so it stretches along the line of sight with
+    range. None when the pixel or its neighbourhood sees no ground (at the horizon).
+    """
+    u, v = foot_px
+    e = 0.5
+    pts = np.array([[u, v], [u + e, v], [u - e, v], [u, v + e], [u, v - e]], dtype=float)
+    g = ego.camera.ground_point(pts)
+    if not np.all(np.isfinite(g)):
+        return None
+    J = np.column_stack([(g[1] - g[2]) / (2 * e), (g[3] - g[4]) / (2 * e)])
+    cov = pixel_noise**2 * (J @ J.T) + min_noise**2 * np.eye(2)
+    return g[0], cov
