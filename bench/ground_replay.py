@@ -1,0 +1,250 @@
+"""Ground-motion estimators judged on a sweep's own foot points, without rendering again.
+
+A sweep's results file keeps, for every frame, the foot point the pipeline found and the
+robot's speed. This replays those foot points through a ground-motion estimator, then
+through the real constant-velocity ground predictor and the real collision warning
+(monopic's own code, as Pipeline.process calls it), and judges the warnings with the
+sweep's own metrics (sim.metrics). So estimators can be compared on hundreds of runs in
+seconds. Compared: the finite differences used up to session 3 (positions in the
+odometry frame differenced over 4 frames, averaged over 4) and the shipped Kalman track
+(monopic/features/ground_track.py), plus any Kalman settings given on the command line.
+
+Only constant-velocity/ground is replayed: its decision depends on nothing but the ground
+track. The agreement column says how many frames' warnings the replay reproduces from the
+file; the estimator that produced the file should agree on nearly all (foot points are
+stored to 0.1 px).
+
+    .venv/bin/python bench/ground_replay.py recordings/medium-s4.jsonl \
+        [--acceleration 1.5 3] [--initial-speed 2] [--no-append]
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import json
+import math
+import shlex
+import sys
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from monopic.camera import CameraModel
+from monopic.features.ground import GroundMotion, Odometry
+from monopic.features.ground_track import GroundTrackConfig
+from monopic.features.motion import VelocityEstimator
+from monopic.frame import EgoState
+from monopic.predict.base import Features, GroundFeatures, Mode
+from monopic.predictors import make_predictor
+from monopic.variants.warning import CollisionWarning
+from monopic.variants.zone import RobotGeometry
+from sim.metrics import FrameCounts, judge_run, summarise
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from common import append_section  # noqa: E402
+
+METHOD = "constant-velocity/ground"
+MAX_GAP = 0.5  # s, FeatureExtractor.max_gap: a longer gap restarts the track
+CAR_MOUNT_FORWARD = 0.8  # m, sim.families' car camera (not in the result line)
+
+
+class Estimator:
+    """The interface both estimators offer (GroundMotion's)."""
+
+    def observe_ego(self, t: float, ego: EgoState) -> None: ...
+    def update(
+        self, t: float, ego: EgoState, foot: tuple[float, float], height: float
+    ) -> tuple[tuple[float, float], tuple[float, float]] | None: ...
+    def reset_track(self) -> None: ...
+
+
+@dataclass
+class FiniteDifferences:
+    """The estimator up to session 3: odometry-frame positions differenced, then averaged."""
+
+    odometry: Odometry = field(default_factory=Odometry)
+    velocity: VelocityEstimator = field(default_factory=lambda: VelocityEstimator(4, 4))
+
+    def observe_ego(self, t: float, ego: EgoState) -> None:
+        self.odometry.update(t, ego)
+
+    def update(self, t, ego, foot, height):
+        g = ego.camera.ground_point(np.array(foot, dtype=float))
+        if not np.all(np.isfinite(g)):
+            return None
+        pos = (float(g[0]), float(g[1]))
+        vx, vy = self.velocity.update(t, *self.odometry.to_fixed(pos))
+        if not (math.isfinite(vx) and math.isfinite(vy)):
+            return pos, (math.nan, math.nan)
+        return pos, self.odometry.rotate_to_robot((vx, vy))
+
+    def reset_track(self) -> None:
+        self.velocity.reset()
+
+
+def camera(row: dict[str, Any]) -> CameraModel:
+    c = row["scenario"]["camera"]
+    forward = CAR_MOUNT_FORWARD if row["scale"] == "car" else 0.0
+    return CameraModel.from_fov(
+        c["width"], c["height"], c["vertical_fov_deg"], c["mount_height"], c["pitch_deg"], forward
+    )
+
+
+def replay(row: dict[str, Any], estimator: Estimator) -> tuple[list, list]:
+    """Per frame: the warning (None without a pose) and the predicted ground point."""
+    s = row["scenario"]
+    cam, horizon = camera(row), s["horizon"]
+    robot = RobotGeometry(
+        width=s["robot_width"], length=s["robot_length"], front=s["robot_length"] / 2
+    )
+    warning = CollisionWarning(robot=robot)
+    predictor = make_predictor("constant-velocity", Mode.GROUND)
+    main, truth = row["pipelines"]["main"], row["truth"]
+    size = (s["camera"]["width"], s["camera"]["height"])
+    warn: list[int | None] = []
+    ground: list[tuple[float, float] | None] = []
+    last = None
+    for k, t in enumerate(truth["t"]):
+        ego = EgoState(cam, truth["robot_speed"][k], 0.0)
+        estimator.observe_ego(t, ego)
+        if last is not None and t - last > MAX_GAP:
+            estimator.reset_track()
+            last = None
+        foot = main["foot"][k] if main["found"][k] else None
+        if foot is None:
+            warn.append(None)
+            ground.append(None)
+            continue
+        last = t
+        got = estimator.update(t, ego, (foot[0], foot[1]), main["height"][k] or 0.0)
+        gf = None if got is None else GroundFeatures(got[0], got[1], cam)
+        feats = Features(t, (foot[0], foot[1]), (foot[0], foot[1]), 0.0, 0.0, 0.0, 0.0, gf)
+        if gf is None:
+            warn.append(0)
+            ground.append(None)
+            continue
+        pred = predictor.predict(feats, horizon)
+        w = warning.assess(feats, pred, Mode.GROUND, size, ego)
+        warn.append(int(w.collision))
+        ground.append(pred.ground)
+    return warn, ground
+
+
+@dataclass
+class Judged:
+    name: str
+    agreement: float
+    outcomes: list
+    errors: np.ndarray
+
+    def row(self) -> str:
+        sm = summarise(METHOD, self.outcomes)
+        f = sum((o.frames for o in self.outcomes), FrameCounts())
+        near = [o for o in self.outcomes if o.near_miss]
+        e = self.errors
+        cells = [
+            self.name,
+            f"{100 * self.agreement:.1f} %",
+            f"{sm.warned_1s}/{sm.collision_runs}",
+            f"{sm.warned}/{sm.collision_runs}",
+            f"{sum(o.warned for o in near)}/{len(near)}",
+            str(f.fp),
+            f"{f.tp / max(f.tp + f.fp, 1):.3f}",
+            f"{f.tp / max(f.tp + f.fn, 1):.3f}",
+            f"{np.percentile(e, 50):.2f} / {np.percentile(e, 90):.2f} / {np.percentile(e, 99):.1f}",
+            f"{100 * np.mean(e > 10):.1f} %",
+        ]
+        return "| " + " | ".join(cells) + " |"
+
+
+def judge(rows: list[dict[str, Any]], name: str, make: Callable[[], Estimator]) -> Judged:
+    outcomes, errors = [], []
+    agree = total = 0
+    for row in rows:
+        warn, ground = replay(row, make())
+        logged = (row["pipelines"]["main"]["decisions"].get(METHOD) or {}).get("warn")
+        logged = logged or [None] * len(warn)
+        agree += sum((a or 0) == (b or 0) for a, b in zip(warn, logged, strict=True))
+        total += len(warn)
+        main = row["pipelines"]["main"]
+        decisions = {METHOD: {**(main["decisions"].get(METHOD) or {}), "warn": warn}}
+        outcomes.append(
+            judge_run({**row, "pipelines": {"main": {**main, "decisions": decisions}}}, METHOD)
+        )
+        for end, fut in zip(ground, row["truth"]["future"], strict=True):
+            if end is not None and fut is not None:
+                errors.append(math.hypot(end[0] - fut[0], end[1] - fut[1]))
+    return Judged(name, agree / max(total, 1), outcomes, np.array(errors))
+
+
+def load(path: Path) -> list[dict[str, Any]]:
+    if not path.is_file():
+        sys.exit(f"{path}: no such results file (write one with `monopic sweep`)")
+    rows = []
+    for n, line in enumerate(path.read_text().splitlines(), 1):
+        try:
+            rows.append(json.loads(line))
+        except json.JSONDecodeError as e:
+            sys.exit(f"{path}:{n}: not a JSON result line ({e.msg})")
+    if not rows:
+        sys.exit(f"{path}: no result lines")
+    return rows
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("results", type=Path)
+    ap.add_argument("--acceleration", type=float, nargs="+", default=[])
+    ap.add_argument("--initial-speed", type=float, nargs="+", default=[])
+    ap.add_argument("--pixel-noise-per-height", type=float, nargs="+", default=[])
+    ap.add_argument("--no-append", action="store_true")
+    args = ap.parse_args()
+    rows = load(args.results)
+    shipped = GroundTrackConfig()
+    candidates: list[tuple[str, Callable[[], Estimator]]] = [
+        ("finite differences (to session 3)", FiniteDifferences),
+        ("Kalman track (shipped)", GroundMotion),
+    ]
+    grid = itertools.product(
+        args.acceleration or [shipped.acceleration],
+        args.initial_speed or [shipped.initial_speed],
+        args.pixel_noise_per_height or [shipped.pixel_noise_per_height],
+    )
+    for a, s0, ph in grid:
+        cfg = GroundTrackConfig(acceleration=a, initial_speed=s0, pixel_noise_per_height=ph)
+        if cfg != shipped:
+            name = f"Kalman, acceleration {a:g}, initial speed {s0:g}, px/height {ph:g}"
+            candidates.append((name, lambda cfg=cfg: GroundMotion(cfg)))
+    lines = [
+        f"{len(rows)} runs of `{args.results}` replayed for {METHOD} (foot points and robot "
+        "speed from the file; the real predictor, warning and metrics). Recall@1s and "
+        "'warned' count collision runs warned at least 1 s / any time before contact; "
+        "frames judge each frame against contact within the horizon; the error is the "
+        "predicted ground point against the true position one horizon later (m).",
+        "",
+        "| estimator | agreement with file | recall@1s | warned | near-miss warned "
+        "| false-alarm frames | frame precision | frame recall | error p50 / p90 / p99 "
+        "| error > 10 m |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for name, make in candidates:
+        judged = judge(rows, name, make)
+        lines.append(judged.row())
+        print(lines[-1], file=sys.stderr)
+    table = "\n".join(lines)
+    print(table)
+    if not args.no_append:
+        argv = " ".join(shlex.quote(a) for a in sys.argv[1:])
+        append_section(
+            "Ground-motion estimators replayed on a sweep's foot points",
+            f".venv/bin/python bench/ground_replay.py {argv}",
+            table,
+        )
+
+
+if __name__ == "__main__":
+    main()
