@@ -5,6 +5,8 @@ from __future__ import annotations
 import datetime as dt
 import os
 import platform
+import shlex
+import sys
 from pathlib import Path
 
 BENCHMARKS = Path(__file__).resolve().parents[1] / "BENCHMARKS.md"
@@ -30,3 +32,10 @@ def append_section(title: str, command: str, body: str) -> None:
     text = f"\n## {title}\n\n`{command}`  \n{machine()}, {stamp}\n\n{body.rstrip()}\n"
     with BENCHMARKS.open("a") as fh:
         fh.write(text)
+
+
+def append_this_run(title: str, body: str) -> None:
+    """Append a section whose command is the benchmark command line just run."""
+    script = Path(sys.argv[0]).name
+    command = f".venv/bin/python bench/{script} {shlex.join(sys.argv[1:])}".rstrip()
+    append_section(title, command, body)

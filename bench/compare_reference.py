@@ -18,7 +18,6 @@ from __future__ import annotations
 import argparse
 import json
 import os
-import shlex
 import subprocess
 import sys
 import time
@@ -29,7 +28,7 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from common import append_section  # noqa: E402
+from common import append_this_run  # noqa: E402
 from frameset import FrameSet, build, load  # noqa: E402
 from paired import paired_median_difference  # noqa: E402
 from reference_env import ensure  # noqa: E402
@@ -364,12 +363,7 @@ def main() -> None:
     table = "\n".join(lines)
     print(table)
     if not args.no_append:
-        argv = " ".join(shlex.quote(a) for a in sys.argv[1:])
-        append_section(
-            "Ours vs the reference pipeline (MediaPipe 0.10.14 + rule cascade)",
-            f".venv/bin/python bench/compare_reference.py {argv}".rstrip(),
-            table,
-        )
+        append_this_run("Ours vs the reference pipeline (MediaPipe 0.10.14 + rule cascade)", table)
 
 
 if __name__ == "__main__":

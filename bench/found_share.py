@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import shlex
 import sys
 import time
 from dataclasses import dataclass, replace
@@ -34,7 +33,7 @@ from sim.scenario import CameraSpec, RobotSpec, Scenario
 from sim.world import World
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import append_section  # noqa: E402
+from common import append_this_run  # noqa: E402
 
 BUCKETS = (
     (0.0, 1 / 8),
@@ -191,8 +190,7 @@ def main() -> None:
         cv2.imwrite(str(args.montage), cv2.cvtColor(montage(thumbs), cv2.COLOR_RGB2BGR))
         print(f"montage of one frame per case -> {args.montage}")
     if not args.no_append:
-        command = ".venv/bin/python bench/found_share.py " + shlex.join(sys.argv[1:])
-        append_section("Pose found share on rendered frames (issue 4)", command.strip(), body)
+        append_this_run("Pose found share on rendered frames (issue 4)", body)
 
 
 def annotate(image: np.ndarray, label: str, box: tuple, result: object) -> np.ndarray:

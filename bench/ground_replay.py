@@ -24,7 +24,6 @@ import argparse
 import itertools
 import json
 import math
-import shlex
 import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -45,7 +44,7 @@ from monopic.variants.zone import RobotGeometry
 from sim.metrics import FrameCounts, judge_run, summarise
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import append_section  # noqa: E402
+from common import append_this_run  # noqa: E402
 
 METHOD = "constant-velocity/ground"
 MAX_GAP = 0.5  # s, FeatureExtractor.max_gap: a longer gap restarts the track
@@ -238,12 +237,7 @@ def main() -> None:
     table = "\n".join(lines)
     print(table)
     if not args.no_append:
-        argv = " ".join(shlex.quote(a) for a in sys.argv[1:])
-        append_section(
-            "Ground-motion estimators replayed on a sweep's foot points",
-            f".venv/bin/python bench/ground_replay.py {argv}",
-            table,
-        )
+        append_this_run("Ground-motion estimators replayed on a sweep's foot points", table)
 
 
 if __name__ == "__main__":

@@ -14,7 +14,6 @@ the worst case over inputs and the mean over the recorded frames.
 from __future__ import annotations
 
 import argparse
-import shlex
 import sys
 import time
 from pathlib import Path
@@ -39,7 +38,7 @@ from monopic.variants.warning import CollisionWarning
 from sim.scenario import CameraSpec
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import append_section  # noqa: E402
+from common import append_this_run  # noqa: E402
 from frameset import build, load  # noqa: E402
 
 PAPER_TREE_MS = 8.0
@@ -175,12 +174,7 @@ def main() -> None:
     table = "\n".join(lines)
     print(table)
     if not args.no_append:
-        argv = " ".join(shlex.quote(a) for a in sys.argv[1:])
-        append_section(
-            "Stage after pose: time and operation count",
-            f".venv/bin/python bench/post_pose.py {argv}".rstrip(),
-            table,
-        )
+        append_this_run("Stage after pose: time and operation count", table)
 
 
 if __name__ == "__main__":

@@ -18,7 +18,6 @@ import argparse
 import json
 import os
 import resource
-import shlex
 import statistics
 import subprocess
 import sys
@@ -28,7 +27,7 @@ from typing import Any
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from common import append_section  # noqa: E402
+from common import append_this_run  # noqa: E402
 
 REALTIME_FPS = 15.0
 CASES = (1, 2, 3, 4, 5, 6, 8)  # walking cases; still (9) has no motion to predict
@@ -233,12 +232,7 @@ def main() -> None:
     table = "\n".join(lines)
     print(table)
     if not args.no_append:
-        argv = " ".join(shlex.quote(a) for a in sys.argv[1:])
-        append_section(
-            "Simulator: render time, scenario run on one core, sweep throughput",
-            f".venv/bin/python bench/simulator.py {argv}".rstrip(),
-            table,
-        )
+        append_this_run("Simulator: render time, scenario run on one core, sweep throughput", table)
 
 
 if __name__ == "__main__":

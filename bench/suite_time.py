@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import shlex
 import subprocess
 import sys
 import time
@@ -18,7 +17,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from common import append_section  # noqa: E402
+from common import append_this_run  # noqa: E402
 
 ROOT = HERE.parent
 SUITES = (
@@ -54,12 +53,7 @@ def main() -> None:
     table = "\n".join(lines)
     print(table)
     if not args.no_append:
-        argv = " ".join(shlex.quote(a) for a in sys.argv[1:])
-        append_section(
-            "Test suite run time",
-            f".venv/bin/python bench/suite_time.py {argv}".rstrip(),
-            table,
-        )
+        append_this_run("Test suite run time", table)
 
 
 if __name__ == "__main__":
