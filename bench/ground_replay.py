@@ -15,7 +15,7 @@ file; the estimator that produced the file should agree on nearly all (foot poin
 stored to 0.1 px).
 
     .venv/bin/python bench/ground_replay.py recordings/medium-s4.jsonl \
-        [--acceleration 1.5 3] [--initial-speed 2] [--no-append]
+        [--acceleration 1.5 3] [--initial-speed 2] [--plot errors.png] [--no-append]
 """
 
 from __future__ import annotations
@@ -31,12 +31,14 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+from matplotlib.figure import Figure
 
 from monopic.camera import CameraModel
 from monopic.features.ground import GroundMotion, Odometry
 from monopic.features.ground_track import GroundTrackConfig
 from monopic.features.motion import VelocityEstimator
 from monopic.frame import EgoState
+from monopic.output import atomic_path
 from monopic.predict.base import Features, GroundFeatures, Mode
 from monopic.predictors import make_predictor
 from monopic.variants.warning import CollisionWarning
@@ -180,6 +182,24 @@ def judge(rows: list[dict[str, Any]], name: str, make: Callable[[], Estimator]) 
     return Judged(name, agree / max(total, 1), outcomes, np.array(errors))
 
 
+def plot(judged: list[Judged], path: Path, title: str) -> None:
+    """Share of predictions within each error, one curve per estimator (log scale)."""
+    fig = Figure(figsize=(8, 4.5), layout="constrained")
+    ax = fig.add_subplot()
+    for j in judged:
+        e = np.sort(j.errors)
+        ax.plot(e, np.arange(1, len(e) + 1) / len(e), label=j.name)
+    ax.set_xscale("log")
+    ax.set_xlim(0.05, 200)
+    ax.set_xlabel("error of the predicted ground point one horizon ahead (m)")
+    ax.set_ylabel("share of predictions within")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(loc="lower right", fontsize=8)
+    ax.set_title(title, fontsize=10)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=110)
+
+
 def load(path: Path) -> list[dict[str, Any]]:
     if not path.is_file():
         sys.exit(f"{path}: no such results file (write one with `monopic sweep`)")
@@ -200,6 +220,7 @@ def main() -> None:
     ap.add_argument("--acceleration", type=float, nargs="+", default=[])
     ap.add_argument("--initial-speed", type=float, nargs="+", default=[])
     ap.add_argument("--pixel-noise-per-height", type=float, nargs="+", default=[])
+    ap.add_argument("--plot", type=Path, help="PNG of the error distributions")
     ap.add_argument("--no-append", action="store_true")
     args = ap.parse_args()
     rows = load(args.results)
@@ -230,10 +251,14 @@ def main() -> None:
         "| error > 10 m |",
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
+    judged = []
     for name, make in candidates:
-        judged = judge(rows, name, make)
-        lines.append(judged.row())
+        judged.append(judge(rows, name, make))
+        lines.append(judged[-1].row())
         print(lines[-1], file=sys.stderr)
+    if args.plot:
+        plot(judged, args.plot, f"{len(rows)} runs of {args.results.name}, {METHOD}")
+        lines += ["", f"![error distributions]({args.plot})"]
     table = "\n".join(lines)
     print(table)
     if not args.no_append:
