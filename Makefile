@@ -21,7 +21,7 @@ demo: $(STAMP)
 	@mkdir -p recordings
 	$(BIN)/monopic video tests/data/walk_clip.mp4 --variant warning \
 		--out recordings/demo.mp4 --csv recordings/demo.csv --rrd recordings/demo.rrd
-	$(BIN)/monopic sweep scenarios/sweeps/demo.toml --out recordings/demo.jsonl
+	$(BIN)/monopic sweep scenarios/sweeps/demo.toml --out recordings/demo.jsonl --restart
 	$(BIN)/monopic report recordings/demo.jsonl --out recordings/demo_report
 
 test: $(STAMP) lint

@@ -31,6 +31,7 @@ from typing import Any
 import numpy as np
 
 from monopic.cases import Case
+from sim.code_version import UNKNOWN
 
 Z95 = 1.959963984540054
 MAIN = "main"
@@ -575,6 +576,7 @@ class SweepMetrics:
     seeds: int
     frame_sizes: tuple[str, ...]
     machines: tuple[str, ...]
+    codes: tuple[str, ...] = ()  # sim.code_version of the runs ("unknown" before it existed)
 
 
 def _machine(row: dict[str, Any]) -> str:
@@ -616,4 +618,5 @@ def compute(rows: Sequence[dict[str, Any]]) -> SweepMetrics:
         seeds=len({r["seed"] for r in rows}),
         frame_sizes=tuple(sizes),
         machines=tuple(machines),
+        codes=tuple(sorted({str(r.get("code") or UNKNOWN) for r in rows})),
     )

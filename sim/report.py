@@ -100,7 +100,8 @@ def headline(m: SweepMetrics) -> str:
 def ran_on(m: SweepMetrics) -> str:
     return (
         f"{m.rows} runs in {len(m.families)} families, {m.seeds} seeds, frames "
-        f"{', '.join(m.frame_sizes)}, on {', '.join(m.machines) or 'an unknown machine'}"
+        f"{', '.join(m.frame_sizes)}, on {', '.join(m.machines) or 'an unknown machine'}, "
+        + (f"code {m.codes[0]}" if len(m.codes) == 1 else f"MIXED code {', '.join(m.codes)}")
     )
 
 

@@ -11,13 +11,15 @@ from __future__ import annotations
 import fcntl
 import json
 import os
+from collections import Counter
 from collections.abc import Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 from monopic.closing import Closing
 from monopic.errors import UserError
+from sim.code_version import UNKNOWN
 
 
 @dataclass(frozen=True)
@@ -27,6 +29,11 @@ class ResultsState:
     ids: frozenset[str]
     good_bytes: int  # length of the prefix made of complete lines
     torn: bool  # a partial last line follows the good prefix
+    codes: Counter[str] = field(default_factory=Counter)  # lines per code version
+
+    def other_code(self, code: str) -> Counter[str]:
+        """Lines made by code other than `code`, per code version."""
+        return Counter({c: n for c, n in self.codes.items() if c != code})
 
 
 def scan(path: Path) -> ResultsState:
@@ -38,6 +45,7 @@ def scan(path: Path) -> ResultsState:
     if not path.exists():
         return ResultsState(frozenset(), 0, False)
     ids: set[str] = set()
+    codes: Counter[str] = Counter()
     good = 0
     *complete, tail = path.read_bytes().split(b"\n")
     for number, raw in enumerate(complete, start=1):
@@ -51,9 +59,10 @@ def scan(path: Path) -> ResultsState:
                 f"{path}:{number}: not a result line ({err}); remove it or use another --out"
             ) from None
         ids.add(run_id)
+        codes[str(row.get("code") or UNKNOWN)] += 1
         good += len(raw) + 1
     # Lines are written whole, newline included: an unterminated tail is a torn write.
-    return ResultsState(frozenset(ids), good, bool(tail))
+    return ResultsState(frozenset(ids), good, bool(tail), codes)
 
 
 def read_rows(path: Path) -> Iterator[dict[str, Any]]:

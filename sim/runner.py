@@ -68,6 +68,7 @@ class RunSpec:
     # or raised a false alarm, "all" keeps every run, "none" records nothing.
     record: str = "none"
     record_dir: str = ""
+    code: str = ""  # sim.code_version of the code that runs it, written into the result
 
 
 def robot_geometry(scenario: Scenario) -> RobotGeometry:
@@ -323,6 +324,7 @@ def run(
         "scale": spec.scale,
         "params": spec.params,
         "seed": scenario.seed,
+        "code": spec.code or None,
         "scenario": scenario_summary(scenario),
         "frames": len(truth_log.cols["t"]),
         "contact_time": contact_time,

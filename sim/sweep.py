@@ -33,7 +33,8 @@ from typing import Any
 from tqdm import tqdm
 
 from monopic.errors import UserError
-from sim.results_file import ResultsWriter
+from sim.code_version import code_version
+from sim.results_file import ResultsWriter, scan
 from sim.runner import RunSpec
 from sim.scenario_file import (
     ScenarioFile,
@@ -198,6 +199,20 @@ def recordings_folder(out: Path, record_dir: Path | None = None) -> Path:
     return record_dir if record_dir is not None else out.parent / f"{out.stem}_rrd"
 
 
+def set_aside(out: Path, folder: Path, tag: str) -> None:
+    """Rename a stale results file and its recordings folder to <name>.<tag>..., refusing
+    to overwrite an earlier one."""
+    moves = [(out, out.with_name(f"{out.stem}.{tag}{out.suffix}"))]
+    if folder.exists():
+        moves.append((folder, folder.with_name(f"{folder.name}.{tag}")))
+    for _, target in moves:
+        if target.exists():
+            raise UserError(f"{target}: already there; move it away to restart {out}")
+    for source, target in moves:
+        source.rename(target)
+        print(f"set aside: {source} -> {target}", file=sys.stderr)
+
+
 def run_sweep(
     spec: SweepSpec,
     out: Path,
@@ -207,20 +222,34 @@ def run_sweep(
     limit: int | None = None,
     record: str = "failed",
     record_dir: Path | None = None,
+    restart: bool = False,
 ) -> SweepOutcome:
     """Run every run of `spec` missing from `out`, appending each result as it finishes.
 
     `ablation` overrides the spec's flag; `limit` stops after that many new runs (to
     measure a rate, or to test resuming). `record` ("failed", "all" or "none") says which
     runs keep a .rrd recording in `record_dir` (default: beside the results file).
+    A results file holding runs of other code (sim.code_version) is not resumed: that
+    is an error, or with `restart` the file and its recordings are set aside first.
     """
+    code = code_version()
     runs = expand_spec(spec)
     if ablation is not None:
         runs = [replace(r, ablation=ablation) for r in runs]
-    folder = str(recordings_folder(out, record_dir))
-    runs = [replace(r, record=record, record_dir=folder) for r in runs]
+    folder = recordings_folder(out, record_dir)
+    runs = [replace(r, record=record, record_dir=str(folder), code=code) for r in runs]
     if not out.parent.is_dir():
         raise UserError(f"{out}: its folder {out.parent} does not exist")
+    other = scan(out).other_code(code) if out.exists() else None
+    if other:
+        if not restart:
+            versions = ", ".join(f"{n} by {c}" for c, n in other.most_common())
+            raise UserError(
+                f"{out}: holds runs of other code ({versions}; this code is {code}), and a "
+                "sweep resumes only its own code's runs; use another --out, or --restart to "
+                "set the old results aside and start over"
+            )
+        set_aside(out, folder, other.most_common(1)[0][0] if len(other) == 1 else "mixed")
     with ResultsWriter(out) as writer:
         state = writer.state
         todo = [r for r in runs if r.id not in state.ids]

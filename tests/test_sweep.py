@@ -10,6 +10,7 @@ import pytest
 
 from monopic.cli.main import main
 from monopic.errors import UserError
+from sim.code_version import code_version
 from sim.executors import local_executor, ray_executor, ray_runtime_env, work
 from sim.render import KeptRenderContext
 from sim.results_file import ResultsWriter, read_rows, scan
@@ -132,8 +133,10 @@ def test_sweep_writes_one_line_per_run_and_resumes_without_loss(
     assert sorted(again) == sorted(ids)
     assert again[last["id"]] == deterministic_part(last)  # deterministic per run
 
-    # Every line holds both pipelines side by side with the truth, frame for frame.
+    # Every line holds both pipelines side by side with the truth, frame for frame, and
+    # says which code made it.
     row = next(iter(read_rows(out)))
+    assert row["code"] == code_version()
     assert set(row["pipelines"]) == {"main", "gtcrop"}
     n = row["frames"]
     assert len(row["truth"]["t"]) == n
@@ -151,6 +154,32 @@ def test_sweep_writes_one_line_per_run_and_resumes_without_loss(
     (row,) = read_rows(everything)
     rrd = tmp_path / "all_rrd" / row["recording"]
     assert rows_per_entity(rrd)["/camera/image"] == row["frames"]
+
+
+def test_results_of_other_code_are_not_resumed_but_set_aside_on_request(
+    spec_path: Path, tmp_path: Path
+) -> None:
+    spec = load_spec(spec_path)
+    out = tmp_path / "results.jsonl"
+    ids = [r.id for r in expand_spec(spec)]
+    old = [{"id": ids[0], "code": "0123456789ab"}, {"id": ids[1]}]  # the second: no code
+    out.write_text("".join(json.dumps(r) + "\n" for r in old))
+    (tmp_path / "results_rrd").mkdir()
+    with pytest.raises(UserError, match=r"1 by 0123456789ab, 1 by unknown.*--restart"):
+        run_sweep(spec, out, local_executor(1), progress=False)
+    assert out.read_text().count("\n") == 2  # untouched
+
+    outcome = run_sweep(spec, out, local_executor(1), progress=False, limit=1, restart=True)
+    assert (outcome.finished, outcome.skipped) == (1, 0)  # nothing of the old code kept
+    assert (tmp_path / "results.mixed.jsonl").read_text().count("\n") == 2
+    assert (tmp_path / "results_rrd.mixed").is_dir()
+    assert [r["code"] for r in read_rows(out)] == [code_version()]
+    # The same code resumes as before; a second restart would not overwrite the first.
+    assert run_sweep(spec, out, local_executor(1), progress=False, limit=0).skipped == 1
+    (tmp_path / "results.unknown.jsonl").write_text("")
+    out.write_text(json.dumps(old[1]) + "\n")
+    with pytest.raises(UserError, match="already there"):
+        run_sweep(spec, out, local_executor(1), progress=False, restart=True)
 
 
 @pytest.mark.slow

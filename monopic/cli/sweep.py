@@ -39,12 +39,19 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--recordings", type=Path, help="folder for the .rrd files (default: <out>_rrd/ beside it)"
     )
     p.add_argument("--limit", type=positive_int, help="run at most this many new runs, then stop")
+    p.add_argument(
+        "--restart",
+        action="store_true",
+        help="if OUT holds runs made by other code, rename it (and its recordings) to "
+        "<name>.<code>.jsonl and start over; without it such a file is an error",
+    )
     p.add_argument("--dry-run", action="store_true", help="expand and check the spec, run nothing")
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from monopic.errors import UserError
+    from sim.code_version import code_version
     from sim.executors import local_executor, ray_executor
     from sim.results_file import scan
     from sim.sweep import expand_spec, load_spec, recordings_folder, run_sweep
@@ -57,10 +64,15 @@ def run(args: argparse.Namespace) -> int:
     out = args.out or Path("recordings") / f"{spec.name}.jsonl"
     if args.dry_run:
         runs = expand_spec(spec)
-        done = scan(out).ids if out.exists() else frozenset()
+        state = scan(out) if out.exists() else None
+        done = state.ids if state else frozenset()
         families = sorted({r.family for r in runs})
         print(f"{spec.path}: {len(runs)} runs in {len(families)} families, "
               f"{sum(r.id in done for r in runs)} already in {out}")  # fmt: skip
+        other = state.other_code(code_version()) if state else None
+        if other:
+            print(f"{out}: {sum(other.values())} of its runs were made by other code "
+                  "(a sweep would stop; --restart sets them aside)")  # fmt: skip
         return 0
     if args.executor == "ray":
         executor = ray_executor(args.address)
@@ -74,6 +86,7 @@ def run(args: argparse.Namespace) -> int:
         limit=args.limit,
         record=args.record,
         record_dir=args.recordings,
+        restart=args.restart,
     )
     rate = outcome.finished / outcome.seconds if outcome.seconds > 0 else 0.0
     print(
