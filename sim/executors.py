@@ -53,11 +53,28 @@ def work(spec: RunSpec, kept: KeptRenderContext | None = None) -> dict[str, Any]
 
 
 def _worker(tasks: Queue, results: Queue) -> None:
-    """A local worker process: runs specs from `tasks` until None; Ctrl-C is the parent's."""
+    """A local worker process: runs specs from `tasks` until None; Ctrl-C is the parent's.
+
+    If the parent dies without stopping it (kill -9, out of memory), the worker notices
+    between runs and exits instead of running the rest of the sweep for nobody.
+    """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    parent = multiprocessing.parent_process()
     with KeptRenderContext() as kept:
-        for spec in iter(tasks.get, None):
+        while (spec := _next_task(tasks, parent)) is not None:
             results.put(work(spec, kept))
+    if parent is not None and not parent.is_alive():
+        results.cancel_join_thread()  # nobody will read what is still queued
+
+
+def _next_task(tasks: Queue, parent: BaseProcess | None) -> RunSpec | None:
+    """The next spec, or None at the stop sign or once the parent is gone."""
+    while parent is None or parent.is_alive():
+        try:
+            return tasks.get(timeout=1.0)
+        except queue.Empty:
+            continue
+    return None
 
 
 @contextlib.contextmanager

@@ -4,6 +4,11 @@ identical results on Ray, and the two commands."""
 from __future__ import annotations
 
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 from pathlib import Path
 
 import pytest
@@ -180,6 +185,62 @@ def test_results_of_other_code_are_not_resumed_but_set_aside_on_request(
     out.write_text(json.dumps(old[1]) + "\n")
     with pytest.raises(UserError, match="already there"):
         run_sweep(spec, out, local_executor(1), progress=False, restart=True)
+
+
+def _children(pid: int) -> set[int]:
+    path = Path(f"/proc/{pid}/task/{pid}/children")
+    return {int(x) for x in path.read_text().split()} if path.exists() else set()
+
+
+def _alive(pid: int) -> bool:
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except FileNotFoundError:
+        return False
+    return stat.rsplit(")", 1)[1].split()[0] != "Z"  # a zombie has exited
+
+
+def _sweep_until_first_result(spec_path: Path, out: Path) -> tuple[subprocess.Popen, set[int]]:
+    cmd = [sys.executable, "-m", "monopic", "sweep", str(spec_path), "--out", str(out)]
+    proc = subprocess.Popen([*cmd, "--workers", "2", "--record", "none"], stderr=subprocess.PIPE)
+    deadline = time.monotonic() + 180
+    while not (out.exists() and out.read_text().count("\n") >= 1):
+        assert proc.poll() is None and time.monotonic() < deadline, "no result came"
+        time.sleep(0.2)
+    workers = _children(proc.pid)
+    assert workers, "the sweep runs in worker processes"
+    return proc, workers
+
+
+def _gone_within(pids: set[int], seconds: float) -> bool:
+    deadline = time.monotonic() + seconds
+    while any(_alive(p) for p in pids):
+        if time.monotonic() > deadline:
+            return False
+        time.sleep(0.2)
+    return True
+
+
+@pytest.mark.slow
+def test_stopping_a_sweep_stops_its_workers(spec_path: Path, tmp_path: Path) -> None:
+    # SIGTERM: the sweep stops its workers itself and says so in one line.
+    proc, workers = _sweep_until_first_result(spec_path, tmp_path / "term.jsonl")
+    proc.send_signal(signal.SIGTERM)
+    _, err = proc.communicate(timeout=60)
+    assert proc.returncode == 143 and err.decode().strip().endswith("terminated")
+    assert _gone_within(workers, 10)
+    # SIGKILL leaves no chance to clean up: the workers notice their parent is gone and
+    # exit after the run they are in, instead of running the rest of the sweep (80 runs
+    # of a second or more each: 40 s and more for two workers).
+    speeds = ", ".join(f"{0.0375 * k:.4f}" for k in range(80))
+    (tmp_path / "tiny.toml").write_text(
+        SCENARIO.replace('"robot.speed" = [0.0, 1.0, 2.0]', f'"robot.speed" = [{speeds}]')
+    )
+    spec_path.write_text(SPEC.format(ablation="false"))
+    proc, workers = _sweep_until_first_result(spec_path, tmp_path / "kill.jsonl")
+    os.kill(proc.pid, signal.SIGKILL)
+    proc.wait(timeout=10)
+    assert _gone_within(workers, 15)
 
 
 @pytest.mark.slow
