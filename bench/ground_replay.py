@@ -28,7 +28,7 @@ import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -53,7 +53,7 @@ MAX_GAP = 0.5  # s, FeatureExtractor.max_gap: a longer gap restarts the track
 CAR_MOUNT_FORWARD = 0.8  # m, sim.families' car camera (not in the result line)
 
 
-class Estimator:
+class Estimator(Protocol):
     """The interface both estimators offer (GroundMotion's)."""
 
     def observe_ego(self, t: float, ego: EgoState) -> None: ...
