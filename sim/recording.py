@@ -339,6 +339,11 @@ class SimRecording(WholeOrNothing):
     `abort()` on an exception and `close()` otherwise.
     """
 
+    @property
+    def rec(self) -> rr.RecordingStream:
+        """The run's stream (not kept here: closing the run frees it)."""
+        return self.run.rec
+
     def __init__(
         self,
         path: Path,
@@ -355,7 +360,6 @@ class SimRecording(WholeOrNothing):
         self.topdown_every = topdown_every
         # The file starts on the first step, when the blueprint can frame the world.
         self.run = RunRecording(Path(path), application_id, recording_id or self.scenario.name)
-        self.rec = self.run.rec
         self._topdown: TopDownCamera | None = None
         self._static_done = False
         self._robot_trail: list[list[float]] = []

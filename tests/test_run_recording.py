@@ -3,8 +3,10 @@
 from pathlib import Path
 
 import pytest
+import rerun as rr
 
 from monopic.recording import RunRecording
+from tests.rrd import rows_per_entity
 
 
 def test_recording_appears_only_when_the_run_ends_without_an_error(tmp_path: Path) -> None:
@@ -15,3 +17,29 @@ def test_recording_appears_only_when_the_run_ends_without_an_error(tmp_path: Pat
         raise RuntimeError("the run broke")
     assert good.exists() and good.stat().st_size > 0
     assert sorted(p.name for p in tmp_path.iterdir()) == ["good.rrd"]  # no temporary left
+
+
+def _threads() -> int:
+    status = Path("/proc/self/status").read_text().splitlines()
+    return int(next(line for line in status if line.startswith("Threads:")).split()[1])
+
+
+def test_dropped_recordings_free_their_threads(tmp_path: Path) -> None:
+    # rerun keeps a dropped stream's batcher threads and buffers until a cleanup pass; a
+    # sweep worker records every run and drops most of them, so each must be freed.
+    counts = []
+    for k in range(4):
+        rec = RunRecording(tmp_path / f"r{k}.rrd")
+        rec.abort()
+        counts.append(_threads())
+    assert counts[-1] <= counts[0], counts
+    assert not list(tmp_path.iterdir())
+    # Kept ones too, blueprint included (rerun makes a stream for it).
+    counts = []
+    for k in range(4):
+        rec = RunRecording(tmp_path / f"k{k}.rrd")
+        rec.rec.log("features/phi", rr.Scalars(float(k)))
+        rec.close()
+        counts.append(_threads())
+    assert counts[-1] <= counts[0], counts
+    assert rows_per_entity(tmp_path / "k3.rrd") == {"/features/phi": 1}  # whole, readable
