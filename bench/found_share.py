@@ -28,9 +28,9 @@ import numpy as np
 
 from monopic.cases import Case
 from monopic.pose.tracker import PoseTracker, TrackerConfig
-from sim.cases import place_case
-from sim.scenario import CameraSpec, RobotSpec, Scenario
-from sim.world import World
+from sim.scenario.cases import place_case
+from sim.scenario.spec import CameraSpec, RobotSpec, Scenario
+from sim.world.world import World
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import append_this_run  # noqa: E402

@@ -85,9 +85,9 @@ def _rendered(case: int, distance: float, frames: int):
     from dataclasses import replace
 
     from monopic.cases import Case
-    from sim.cases import place_case
-    from sim.ground_truth import in_image
-    from sim.world import World
+    from sim.scenario.cases import place_case
+    from sim.world.ground_truth import in_image
+    from sim.world.world import World
 
     duration = frames / 15.0
     sc = place_case(

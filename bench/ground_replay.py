@@ -4,7 +4,7 @@ A sweep's results file keeps, for every frame, the foot point the pipeline found
 robot's speed. This replays those foot points through a ground-motion estimator, then
 through the real constant-velocity ground predictor and the real collision warning
 (monopic's own code, as Pipeline.process calls it), and judges the warnings with the
-sweep's own metrics (sim.metrics). So estimators can be compared on hundreds of runs in
+sweep's own metrics (sim.analysis.metrics). So estimators can be compared on hundreds of runs in
 seconds. Compared: the finite differences used up to session 3 (positions in the
 odometry frame differenced over 4 frames, averaged over 4) and the shipped Kalman track
 (monopic/features/ground_track.py), plus any Kalman settings given on the command line.
@@ -37,20 +37,21 @@ from monopic.camera import CameraModel
 from monopic.features.ground import GroundMotion, Odometry
 from monopic.features.ground_track import GroundTrackConfig
 from monopic.features.motion import VelocityEstimator
+from monopic.features.record import Features, GroundFeatures
 from monopic.frame import EgoState
 from monopic.output import atomic_path
-from monopic.predict.base import Features, GroundFeatures, Mode
-from monopic.predictors import make_predictor
+from monopic.predict.base import Mode
+from monopic.predict.registry import make_predictor
 from monopic.variants.warning import CollisionWarning
 from monopic.variants.zone import RobotGeometry
-from sim.metrics import FrameCounts, judge_run, summarise
+from sim.analysis.metrics import FrameCounts, judge_run, summarise
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import append_this_run  # noqa: E402
 
 METHOD = "constant-velocity/ground"
 MAX_GAP = 0.5  # s, FeatureExtractor.max_gap: a longer gap restarts the track
-CAR_MOUNT_FORWARD = 0.8  # m, sim.families' car camera (not in the result line)
+CAR_MOUNT_FORWARD = 0.8  # m, sim.scenario.families' car camera (not in the result line)
 
 
 class Estimator(Protocol):

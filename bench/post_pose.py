@@ -24,7 +24,7 @@ from monopic.features.extractor import FeatureExtractor
 from monopic.frame import EgoState
 from monopic.pose.tracker import PoseTracker, TrackerConfig
 from monopic.predict.base import Mode
-from monopic.predictors import make_predictor
+from monopic.predict.registry import make_predictor
 from monopic.tree.model import TreePredictor
 from monopic.tree.opcount import (
     PAPER_CALCULATIONS_PER_PREDICTION,
@@ -35,7 +35,7 @@ from monopic.tree.opcount import (
 )
 from monopic.variants.path import project_path
 from monopic.variants.warning import CollisionWarning
-from sim.scenario import CameraSpec
+from sim.scenario.spec import CameraSpec
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
 from common import append_this_run  # noqa: E402
@@ -44,7 +44,7 @@ from frameset import build, load  # noqa: E402
 PAPER_TREE_MS = 8.0
 HORIZON = 1.0
 # (label, predictors, with robot state): the paper's image-mode predictors alone, then
-# the set every simulator run evaluates side by side (sim/runner.py PREDICTORS).
+# the set every simulator run evaluates side by side (sim/runs/runner.py PREDICTORS).
 SETS = (
     ("rules, image (the reference cascade)", (("rules", Mode.IMAGE),), False),
     ("ID3 tree, image", (("tree", Mode.IMAGE),), False),

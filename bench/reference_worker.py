@@ -70,8 +70,9 @@ class ReferenceRunner:
 
         from monopic.features.motion import VelocityEstimator
         from monopic.features.orientation import facing_angle
+        from monopic.features.record import Features
         from monopic.features.smoothing import Kalman1D
-        from monopic.predict.base import Features, Mode
+        from monopic.predict.base import Mode
         from monopic.predict.rules import RulePredictor
         from monopic.variants.path import project_path
         from monopic.variants.warning import CollisionWarning

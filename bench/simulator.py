@@ -1,11 +1,11 @@
 """The simulator's own speed: render time, a whole scenario run on one core, sweep throughput.
 
 Each measurement runs in a fresh child process with the sweep workers' environment
-(sim.executors.WORKER_ENV: one Mesa thread, one BLAS thread; onnxruntime gets one thread
-from sim.runner): render time per frame at 768x432 (World.step with and without
-rendering), frames per second of a whole scenario run (sim.runner.run: render +
+(sim.runs.executors.WORKER_ENV: one Mesa thread, one BLAS thread; onnxruntime gets one thread
+from sim.runs.runner): render time per frame at 768x432 (World.step with and without
+rendering), frames per second of a whole scenario run (sim.runs.runner.run: render +
 pipeline with all five predictors + bookkeeping) pinned to one core with and without
-the ground-truth-crop ablation pipeline, and sweep throughput through sim.executors'
+the ground-truth-crop ablation pipeline, and sweep throughput through sim.runs.executors'
 spawned workers (1 and 2), with the peak RSS of a worker (ru_maxrss of the
 reaped children).
 
@@ -42,7 +42,7 @@ def scenario(case: int, frames: int, seed: int = 0, shadows: bool = True) -> Any
     from dataclasses import replace
 
     from monopic.cases import Case
-    from sim.cases import place_case
+    from sim.scenario.cases import place_case
 
     sc = place_case(Case(case), duration=frames / REALTIME_FPS, seed=seed)
     return replace(sc, scene=replace(sc.scene, shadows=shadows))
@@ -52,7 +52,7 @@ def child_render(frames: int) -> dict[str, Any]:
     """World.step with and without rendering, one core; first frame (GL setup) excluded."""
     import numpy as np
 
-    from sim.world import World
+    from sim.world.world import World
 
     out: dict[str, Any] = {}
     for render in (False, True, False, True):  # alternated, the second pair kept
@@ -74,13 +74,14 @@ def child_render(frames: int) -> dict[str, Any]:
 
 
 def child_run(frames: int, ablation: bool, shadows: bool = True) -> dict[str, Any]:
-    """One whole scenario through sim.runner.run, after one warm-up run; frames per second.
+    """One whole scenario through sim.runs.runner.run, after one warm-up run; frames per second.
 
-    As in a sweep worker, the runs share one GL context (sim.render.KeptRenderContext), so
+    As in a sweep worker, the runs share one GL context (sim.world.render.KeptRenderContext), so
     llvmpipe's shader compilation is paid once by the warm-up, not by every run.
     """
-    from sim.render import KeptRenderContext
-    from sim.runner import RunSpec, run
+    from sim.runs.run_spec import RunSpec
+    from sim.runs.runner import run
+    from sim.world.render import KeptRenderContext
 
     warm = RunSpec(id="warm", scenario=scenario(1, 10), ablation=ablation, stop_at_contact=False)
     results = []
@@ -103,9 +104,9 @@ def child_run(frames: int, ablation: bool, shadows: bool = True) -> dict[str, An
 
 
 def child_sweep(frames: int, runs: int, workers: int) -> dict[str, Any]:
-    """`runs` scenario runs through sim.executors.local_executor with `workers` processes."""
-    from sim.executors import local_executor
-    from sim.runner import RunSpec
+    """`runs` scenario runs through sim.runs.executors.local_executor with `workers` processes."""
+    from sim.runs.executors import local_executor
+    from sim.runs.run_spec import RunSpec
 
     specs = [
         RunSpec(
@@ -133,7 +134,7 @@ def child_sweep(frames: int, runs: int, workers: int) -> dict[str, Any]:
 
 
 def spawn_child(kind: str, pin: bool, **kw: Any) -> dict[str, Any]:
-    from sim.executors import WORKER_ENV
+    from sim.runs.executors import WORKER_ENV
 
     env = dict(os.environ, **WORKER_ENV)
     cmd = [sys.executable, str(Path(__file__).resolve()), "--child", kind]
@@ -184,8 +185,8 @@ def main() -> None:
     load1 = os.getloadavg()[0]
     r, nr = render["render"], render["no_render"]
     lines = [
-        f"Scenarios: sim.cases.place_case, 8 m, robot 2 m/s, {args.frames} frames at 15 fps, "
-        f"768x432; child processes with sim.executors.WORKER_ENV; load average "
+        f"Scenarios: sim.scenario.cases.place_case, 8 m, robot 2 m/s, {args.frames} frames "
+        f"at 15 fps, 768x432; child processes with sim.runs.executors.WORKER_ENV; load average "
         f"{load0:.1f} before, {load1:.1f} after, on {os.cpu_count()} cores; "
         f"{time.perf_counter() - start:.0f} s in all.",
         "",
@@ -195,7 +196,7 @@ def main() -> None:
         f"| without rendering (truth only) | {nr['p50']:.1f} ms | {nr['p95']:.1f} ms |",
         f"| render alone (difference of p50) | {r['p50'] - nr['p50']:.1f} ms | |",
         "",
-        "| whole scenario run on one core (sim.runner.run, GL context kept) | frames "
+        "| whole scenario run on one core (sim.runs.runner.run, GL context kept) | frames "
         "| fps (median of 4 runs) "
         "| CPU-s per frame | vs real time at 15 fps | peak RSS |",
         "| --- | ---: | ---: | ---: | ---: | ---: |",
@@ -213,7 +214,7 @@ def main() -> None:
         )
     lines += [
         "",
-        "| sweep (sim.executors.local_executor, no ablation) | runs | wall | runs per minute "
+        "| sweep (sim.runs.executors.local_executor, no ablation) | runs | wall | runs per minute "
         "| frames per second | speed-up | worker peak RSS |",
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]

@@ -11,11 +11,12 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 
 from monopic.features.extractor import FeatureExtractor
+from monopic.features.record import Features
 from monopic.frame import Frame
 from monopic.pose.region import Region
 from monopic.pose.search import GroundBand
 from monopic.pose.tracker import PoseResult, PoseTracker, TrackerConfig
-from monopic.predict.base import Features, Mode, Prediction, Predictor
+from monopic.predict.base import Mode, Prediction, Predictor
 from monopic.predict.rules import RulePredictor
 from monopic.timing import StageTimer
 from monopic.variants.path import PathProjection, project_path

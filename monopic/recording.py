@@ -1,6 +1,6 @@
 """rerun recordings of a pipeline run: the one logging module of the project.
 
-Entity layout (sim/recording.py adds the simulator's on the same stream: camera/truth,
+Entity layout (sim/recording/sim_recording.py adds the simulator's on the same stream: camera/truth,
 world, topdown, truth, ttc, alarm, robot):
 - camera/image             the frame, JPEG-compressed
 - camera/pose              BlazePose skeleton as keypoints (names, connections)
@@ -18,8 +18,8 @@ predictor's point and path) are pink, each predictor has its own colour
 draws the truth in cyan. The camera view is framed on the image, whatever is drawn
 outside it (the zone's near edge lies below the frame).
 
-Callers that add their own entities (the simulator's sim.recording) log them on the same
-stream, `RunRecording.rec`, after `set_time`, and `start` it with their own blueprint
+Callers that add their own entities (the simulator's sim.recording.sim_recording) log them
+on the same stream, `RunRecording.rec`, after `set_time`, and `start` it with their own blueprint
 before the first frame; a frame the pipeline did not process can still show its image
 (`log_image`). Without a blueprint of the caller's, the file starts on the first image
 with `blueprint(width, height)`.

@@ -1,4 +1,4 @@
-"""Render the end-to-end test clip and its ground truth (see sim/clip.py).
+"""Render the end-to-end test clip and its ground truth (see sim/dataset/clip.py).
 
     .venv/bin/python tools/render_test_clip.py
 
@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.clip import ClipSpec, render_clip
+from sim.dataset.clip import ClipSpec, render_clip
 
 REPO = Path(__file__).resolve().parent.parent
 DEFAULT_VIDEO = REPO / "tests" / "data" / "walk_clip.mp4"

@@ -3,27 +3,25 @@
 from __future__ import annotations
 
 import argparse
-import importlib
 import signal
 import sys
 import threading
 from collections.abc import Sequence
+from importlib.metadata import EntryPoint, entry_points
 
 from monopic.errors import UserError
 
-# Each module defines register(subparsers) which adds its sub-command(s) and sets
-# `func=handler(args) -> int` as the parser default.
-COMMAND_MODULES = (
-    "monopic.cli.video",
-    "monopic.cli.tree",
-    "monopic.cli.replay",
-    "monopic.cli.record",
-    "monopic.cli.view",
-    "monopic.cli.dataset",
-    "monopic.cli.closed_loop",
-    "monopic.cli.sweep",
-    "monopic.cli.report",
-)
+# The commands are read from the `monopic.commands` entry-point group: each entry names a
+# `register(subparsers)` that adds its sub-command(s) and sets `func=handler(args) -> int`
+# as the parser default. This package lists its own (video, tree, replay, view) and the
+# simulator lists its own in the same group (pyproject.toml), so the pipeline never
+# imports the simulator and another installed package adds commands without editing this.
+COMMAND_GROUP = "monopic.commands"
+
+
+def command_entry_points() -> list[EntryPoint]:
+    """The installed commands, by name."""
+    return sorted(entry_points(group=COMMAND_GROUP), key=lambda ep: ep.name)
 
 
 class OneLineParser(argparse.ArgumentParser):
@@ -38,8 +36,21 @@ def build_parser() -> argparse.ArgumentParser:
         prog="monopic", description="MonoPIC pedestrian intention pipeline and test bed"
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
-    for name in COMMAND_MODULES:
-        importlib.import_module(name).register(sub)
+    found = command_entry_points()
+    if not found:
+        raise UserError(
+            f"no commands in the {COMMAND_GROUP!r} entry-point group: install the project "
+            "(pip install -e .) so that its entry points exist"
+        )
+    for ep in found:
+        try:
+            register = ep.load()
+        except Exception as err:  # a broken plug-in must not take the other commands down
+            print(
+                f"monopic: command {ep.name!r} ({ep.value}) failed to load: {err}", file=sys.stderr
+            )
+            continue
+        register(sub)
     return parser
 
 
@@ -52,7 +63,11 @@ def _terminate(signum: int, frame: object) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    parser = build_parser()
+    try:
+        parser = build_parser()
+    except UserError as err:
+        print(f"monopic: error: {err}", file=sys.stderr)
+        return 2
     args = parser.parse_args(argv)
     in_main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminate) if in_main_thread else None

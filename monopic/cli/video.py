@@ -21,7 +21,7 @@ from monopic.overlay import draw
 from monopic.pipeline import Pipeline, PipelineConfig, Variant
 from monopic.pose.tracker import TrackerConfig
 from monopic.predict.base import Mode
-from monopic.predictors import PREDICTOR_NAMES, make_predictor
+from monopic.predict.registry import make_predictor, predictor_names
 from monopic.video import VideoSource
 
 
@@ -34,7 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--rrd", type=Path, help="rerun recording to write")
     p.add_argument("--horizon", type=positive_float, default=1.0, help="seconds ahead (1.0)")
     p.add_argument("--mode", choices=[m.value for m in Mode], default="image")
-    p.add_argument("--predictor", choices=PREDICTOR_NAMES, default="rules")
+    p.add_argument("--predictor", choices=predictor_names(), default="rules")
     p.add_argument("--tree", type=Path, help="tree file for --predictor tree (default: shipped)")
     p.add_argument("--threads", type=positive_int, default=1, help="onnxruntime threads")
     g = p.add_argument_group("camera geometry (needed for ground mode and the projected zone)")

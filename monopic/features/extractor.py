@@ -10,11 +10,11 @@ from monopic.features.ground import GroundMotion
 from monopic.features.ground_track import GroundTrackConfig
 from monopic.features.motion import VelocityEstimator
 from monopic.features.orientation import facing_angle
+from monopic.features.record import Features, GroundFeatures
 from monopic.features.smoothing import Kalman1D
 from monopic.frame import EgoState
 from monopic.pose.landmarks import Pose
 from monopic.pose.skeleton import FOOT_LANDMARKS, LEFT_SHOULDER, RIGHT_SHOULDER
-from monopic.predict.base import Features, GroundFeatures
 
 # Foot landmarks below this visibility are not trusted for the foot point.
 MIN_FOOT_VISIBILITY = 0.5

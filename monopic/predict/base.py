@@ -12,8 +12,8 @@ from typing import Protocol
 
 import numpy as np
 
-from monopic.camera import CameraModel
 from monopic.cases import Case
+from monopic.features.record import Features, Point
 
 
 class Mode(StrEnum):
@@ -26,37 +26,6 @@ class Mode(StrEnum):
 
     IMAGE = "image"
     GROUND = "ground"
-
-
-Point = tuple[float, float]
-
-
-@dataclass(frozen=True)
-class GroundFeatures:
-    """The pedestrian's foot point on the ground, in the robot's current frame."""
-
-    position: Point  # (forward, left) metres
-    velocity: Point  # the pedestrian's own ground velocity (forward, left), m/s
-    camera: CameraModel  # the robot's own camera, to draw ground predictions on the image
-
-
-@dataclass(frozen=True)
-class Features:
-    """Motion features of the tracked pedestrian at one frame.
-
-    Image quantities are pixels (u right, v down) and px/s; phi is the paper's facing
-    angle in degrees (smoothed); `ground` is present only when the camera model is known.
-    """
-
-    timestamp: float
-    center: Point
-    foot: Point
-    apparent_height: float  # px, vertical extent of the landmarks
-    phi: float
-    vx: float
-    vy: float
-    ground: GroundFeatures | None = None
-    phi_raw: float = float("nan")
 
 
 @dataclass(frozen=True)

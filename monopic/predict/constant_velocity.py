@@ -8,9 +8,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 from monopic.cases import GROUND_DEAD_ZONE_MPS, case_from_ground_velocity
-from monopic.predict.base import Features, Mode, Prediction, with_ground_point
+from monopic.features.record import Features
+from monopic.predict.base import Mode, Prediction, with_ground_point
+from monopic.predict.registry import no_model
 from monopic.predict.rules import IMAGE_DEAD_ZONE_PX_S, image_rule_case
 
 
@@ -36,3 +39,9 @@ class ConstantVelocityPredictor:
         case = case_from_ground_velocity(vf, vl, GROUND_DEAD_ZONE_MPS)
         future = (g.position[0] + vf * horizon, g.position[1] + vl * horizon)
         return with_ground_point(features, case, horizon, future)
+
+
+def constant_velocity_predictor(mode: Mode, model: Path | None = None) -> ConstantVelocityPredictor:
+    """The `constant-velocity` entry of the predictor registry."""
+    no_model("constant-velocity", model)
+    return ConstantVelocityPredictor(mode=mode)

@@ -1,29 +1,47 @@
-"""Choosing a predictor by name: the reference rules, the ID3 tree, constant velocity."""
+"""Predictors by name: the `monopic.predictors` entry-point group.
+
+Each entry names a factory `(mode, model_file) -> Predictor`. This package lists the
+authors' rule cascade, constant velocity and the ID3 tree (pyproject.toml); another
+installed package adds its own predictor the same way, and every command that takes a
+predictor name (video, sweeps, the closed loop) then knows it, without editing this one.
+"""
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from functools import cache
+from importlib.metadata import EntryPoint, entry_points
 from pathlib import Path
 
 from monopic.errors import UserError
 from monopic.predict.base import Mode, Predictor
-from monopic.predict.constant_velocity import ConstantVelocityPredictor
-from monopic.predict.rules import RulePredictor
-from monopic.tree.model import TreePredictor
-from monopic.tree.serialise import load_default_model, load_model
 
-PREDICTOR_NAMES = ("rules", "tree", "constant-velocity")
+PREDICTOR_GROUP = "monopic.predictors"
+PredictorFactory = Callable[[Mode, Path | None], Predictor]
 
 
-def make_predictor(name: str, mode: Mode, tree: Path | None = None) -> Predictor:
-    """The named predictor for `mode`; `tree` is a tree file (default: the shipped tree)."""
-    if name == "rules":
-        return RulePredictor(mode=mode)
-    if name == "constant-velocity":
-        return ConstantVelocityPredictor(mode=mode)
-    if name == "tree":
-        model = load_model(tree) if tree is not None else load_default_model()
-        if model.mode is not mode:
-            where = tree if tree is not None else "the shipped default tree"
-            raise UserError(f"{where}: tree was trained for {model.mode} mode, not {mode} mode")
-        return TreePredictor(model)
-    raise UserError(f"unknown predictor {name!r}: choose from {', '.join(PREDICTOR_NAMES)}")
+@cache
+def _registered() -> dict[str, EntryPoint]:
+    """Installed predictors (read once: installed metadata does not change in a run)."""
+    return {ep.name: ep for ep in entry_points(group=PREDICTOR_GROUP)}
+
+
+def predictor_names() -> tuple[str, ...]:
+    """Every installed predictor's name, sorted."""
+    return tuple(sorted(_registered()))
+
+
+def make_predictor(name: str, mode: Mode, model: Path | None = None) -> Predictor:
+    """The named predictor for `mode`; `model` is its model file where it takes one."""
+    entry = _registered().get(name)
+    if entry is None:
+        known = ", ".join(predictor_names()) or "none installed: pip install -e ."
+        raise UserError(f"unknown predictor {name!r}: choose from {known}")
+    factory: PredictorFactory = entry.load()
+    return factory(mode, model)
+
+
+def no_model(name: str, model: Path | None) -> None:
+    """For predictors without a model file: refuse one rather than ignore it."""
+    if model is not None:
+        raise UserError(f"{model}: predictor {name!r} takes no model file")

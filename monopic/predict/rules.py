@@ -14,15 +14,12 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from pathlib import Path
 
 from monopic.cases import GROUND_DEAD_ZONE_MPS, Case, case_from_ground_velocity
-from monopic.predict.base import (
-    Features,
-    Mode,
-    Prediction,
-    extrapolate_ground,
-    extrapolate_image,
-)
+from monopic.features.record import Features
+from monopic.predict.base import Mode, Prediction, extrapolate_ground, extrapolate_image
+from monopic.predict.registry import no_model
 
 IMAGE_DEAD_ZONE_PX_S = 20.0
 
@@ -61,3 +58,9 @@ class RulePredictor:
             else Case.STILL
         )
         return extrapolate_ground(features, case, horizon)
+
+
+def rule_predictor(mode: Mode, model: Path | None = None) -> RulePredictor:
+    """The `rules` entry of the predictor registry."""
+    no_model("rules", model)
+    return RulePredictor(mode=mode)

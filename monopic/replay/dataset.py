@@ -20,7 +20,8 @@ import numpy as np
 
 from monopic.cases import Case, case_from_image_track
 from monopic.features.motion import VelocityEstimator
-from monopic.predict.base import Features, Mode
+from monopic.features.record import Features
+from monopic.predict.base import Mode
 from monopic.replay.logs import AuthorsLog
 from monopic.tree.model import TrainingSample, feature_values
 

@@ -19,7 +19,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from monopic.cases import Case
-from monopic.predict.base import Features, Prediction, Predictor
+from monopic.features.record import Features
+from monopic.predict.base import Prediction, Predictor
 from monopic.predict.constant_velocity import ConstantVelocityPredictor
 from monopic.predict.rules import RulePredictor
 from monopic.replay.dataset import PreparedLog

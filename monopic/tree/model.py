@@ -19,8 +19,8 @@ from typing import Any
 import numpy as np
 
 from monopic.cases import Case
+from monopic.features.record import Features
 from monopic.predict.base import (
-    Features,
     Mode,
     Prediction,
     extrapolate_ground,

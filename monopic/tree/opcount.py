@@ -19,7 +19,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from monopic.cases import Case
-from monopic.predict.base import Features, Mode
+from monopic.features.record import Features
+from monopic.predict.base import Mode
 from monopic.tree.model import (
     LEAF_PLACEMENT_OPS,
     Placement,

@@ -18,7 +18,7 @@ from monopic.output import write_text_atomically
 from monopic.predict.base import Mode
 from monopic.tree.discretise import Discretiser
 from monopic.tree.id3 import DecisionTree
-from monopic.tree.model import TreeModel
+from monopic.tree.model import TreeModel, TreePredictor
 
 FORMAT = "monopic-id3-tree"
 VERSION = 1
@@ -107,3 +107,12 @@ def load_default_model() -> TreeModel:
     """The tree shipped inside the package (see monopic/tree/DEFAULT_TREE.md)."""
     ref = resources.files("monopic.tree").joinpath(DEFAULT_TREE_NAME)
     return _parse(ref.read_text(encoding="utf-8"), f"package data {DEFAULT_TREE_NAME}")
+
+
+def tree_predictor(mode: Mode, model: Path | None = None) -> TreePredictor:
+    """The `tree` entry of the predictor registry: a tree file, or the shipped tree."""
+    tree = load_model(model) if model is not None else load_default_model()
+    if tree.mode is not mode:
+        where = model if model is not None else "the shipped default tree"
+        raise UserError(f"{where}: tree was trained for {tree.mode} mode, not {mode} mode")
+    return TreePredictor(tree)

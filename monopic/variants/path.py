@@ -11,7 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from monopic.predict.base import Features, Prediction
+from monopic.features.record import Features
+from monopic.predict.base import Prediction
 from monopic.variants.zone import points_in_polygon
 
 

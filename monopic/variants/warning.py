@@ -11,8 +11,9 @@ from enum import StrEnum
 
 import numpy as np
 
+from monopic.features.record import Features
 from monopic.frame import EgoState
-from monopic.predict.base import Features, Mode, Prediction
+from monopic.predict.base import Mode, Prediction
 from monopic.variants.zone import (
     RobotGeometry,
     default_image_zone,

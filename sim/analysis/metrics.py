@@ -31,7 +31,7 @@ from typing import Any
 import numpy as np
 
 from monopic.cases import Case
-from sim.code_version import UNKNOWN
+from sim.runs.code_version import UNKNOWN
 
 Z95 = 1.959963984540054
 MAIN = "main"
@@ -576,7 +576,7 @@ class SweepMetrics:
     seeds: int
     frame_sizes: tuple[str, ...]
     machines: tuple[str, ...]
-    codes: tuple[str, ...] = ()  # sim.code_version of the runs ("unknown" before it existed)
+    codes: tuple[str, ...] = ()  # sim.runs.code_version of the runs ("unknown" before it existed)
 
 
 def _machine(row: dict[str, Any]) -> str:

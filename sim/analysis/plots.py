@@ -15,7 +15,7 @@ from matplotlib.figure import Figure
 
 from monopic.cases import Case
 from monopic.output import atomic_path
-from sim.metrics import (
+from sim.analysis.metrics import (
     LEAD_GOAL,
     MAIN,
     RADII,

@@ -1,6 +1,6 @@
 """The sweep report: a Markdown file with PNG plots, and the headline table for the terminal.
 
-Tables come from sim.metrics; plots from sim.plots. Every file is written under a
+Tables come from sim.analysis.metrics; plots from sim.analysis.plots. Every file is written under a
 temporary name and renamed when complete, the Markdown last, so a report directory
 never holds a half-written report.
 """
@@ -14,8 +14,8 @@ from pathlib import Path
 
 from monopic.cases import Case
 from monopic.output import write_text_atomically
-from sim import plots
-from sim.metrics import (
+from sim.analysis import plots
+from sim.analysis.metrics import (
     ABLATION,
     LEAD_GOAL,
     MAIN,

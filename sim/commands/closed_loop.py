@@ -14,7 +14,7 @@ from monopic.errors import UserError
 from monopic.output import write_text_atomically
 
 if TYPE_CHECKING:  # the simulator is imported when the command runs
-    from sim.scenario import Scenario
+    from sim.scenario.spec import Scenario
 
 FAMILY_FOLDER = Path("scenarios/families/small")
 # The Euro NCAP-style collision families at the small robot's scale.
@@ -66,7 +66,7 @@ def _numbers(text: str, option: str) -> list[float]:
 
 def case_scenarios(cases: str, speeds: list[float]) -> list[Scenario]:
     from monopic.cases import Case
-    from sim.cases import place_case
+    from sim.scenario.cases import place_case
 
     out = []
     for text in cases.split(","):
@@ -93,7 +93,7 @@ def case_scenarios(cases: str, speeds: list[float]) -> list[Scenario]:
 
 
 def file_scenarios(files: list[Path], speeds: list[float], seed: int) -> list[Scenario]:
-    from sim.scenario_file import load
+    from sim.scenario.files import load
 
     out = []
     for path in files:
@@ -104,7 +104,7 @@ def file_scenarios(files: list[Path], speeds: list[float], seed: int) -> list[Sc
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim.closed_loop import NO_BRAKE, format_runs, format_table, run_closed_loop, summarise
+    from sim.runs.closed_loop import NO_BRAKE, format_runs, format_table, run_closed_loop, summarise
 
     speeds = _numbers(args.speeds, "--speeds")
     policies = [p.strip() for p in args.policies.split(",") if p.strip()]

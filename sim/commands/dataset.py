@@ -36,7 +36,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim.dataset import build, estimate, expand, load_spec
+    from sim.dataset.build import build, estimate
+    from sim.dataset.spec import expand, load_spec
 
     spec = load_spec(args.spec)
     out: Path = args.out

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import importlib
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -14,14 +13,14 @@ from monopic.cli.args import non_negative_float, positive_float
 from monopic.errors import UserError
 
 if TYPE_CHECKING:  # the simulator is imported when a command runs, not when the CLI starts
-    from sim.scenario import Scenario
+    from sim.scenario.spec import Scenario
 
 DEFAULT_FOLDER = Path("recordings")
 SCENARIO_HELP = """\
 SCENARIO is a case number 1-9 or its name (e.g. 5, case5, perpendicular-right), or
 `crossing` (an adult crossing into the robot's path; contact at 2.7 s unless it
 brakes), or a scenario file (scenarios/**/*.toml: its base scenario, without its sweep).
-Cases are placed by sim.cases.place_case; the options below set its parameters.
+Cases are placed by sim.scenario.cases.place_case; the options below set its parameters.
 """
 
 
@@ -79,23 +78,13 @@ def parse_case(text: str) -> Case | None:
     return None
 
 
-def scenario_from_file(path: Path) -> Scenario:
-    """The base scenario of a scenario file (sim.scenario_file)."""
-    try:
-        module = importlib.import_module("sim.scenario_file")
-    except ModuleNotFoundError:
-        raise UserError(f"{path}: scenario files are not supported in this checkout") from None
-    if hasattr(module, "load_scenario"):
-        return module.load_scenario(path)
-    return module.load(path).base
-
-
 def resolve_scenario(text: str, args: argparse.Namespace) -> Scenario:
     """The Scenario named on the command line (see SCENARIO_HELP)."""
-    from sim.cases import default_crossing, place_case
+    from sim.scenario.cases import default_crossing, place_case
+    from sim.scenario.files import load
 
     if text.endswith(".toml") or Path(text).is_file():
-        return scenario_from_file(Path(text))
+        return load(Path(text)).base
     if text.strip().lower() == "crossing":
         return default_crossing()
     case = parse_case(text)
@@ -119,7 +108,7 @@ def resolve_scenario(text: str, args: argparse.Namespace) -> Scenario:
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim.recording import record_run
+    from sim.runs.record import record_run
 
     if args.topdown_every < 0:
         raise UserError(f"--topdown-every: must be >= 0, got {args.topdown_every}")

@@ -17,9 +17,9 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from monopic.errors import UserError
-    from sim.metrics import compute
-    from sim.report import ran_on, write_report
-    from sim.results_file import read_rows
+    from sim.analysis.metrics import compute
+    from sim.analysis.report import ran_on, write_report
+    from sim.runs.results_file import read_rows
 
     results: Path = args.results
     if not results.is_file():

@@ -51,10 +51,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from monopic.errors import UserError
-    from sim.code_version import code_version
-    from sim.executors import local_executor, ray_executor
-    from sim.results_file import scan
-    from sim.sweep import expand_spec, load_spec, recordings_folder, run_sweep
+    from sim.runs.code_version import code_version
+    from sim.runs.executors import local_executor, ray_executor
+    from sim.runs.results_file import scan
+    from sim.runs.sweep import expand_spec, load_spec, recordings_folder, run_sweep
 
     if args.address and args.executor != "ray":
         raise UserError("--address is for --executor ray")

@@ -1,8 +1,8 @@
 """Synthetic datasets: scenario runs rendered into images, COCO keypoints, masks and truth rows.
 
 A dataset spec (see scenarios/datasets/README.md) is either a case grid ([grid]: every
-combination of sim.cases.place_case parameters is one run) or a sweep spec ([[include]]:
-the runs sim.sweep expands it into, with the sweep's run ids, scenarios and seeds; the ids
+combination of sim.scenario.cases.place_case parameters is one run) or a sweep spec ([[include]]:
+the runs sim.runs.sweep expands it into, with the sweep's run ids, scenarios and seeds; the ids
 hold a slash, so the per-run files below nest a folder deeper). Every frame of a run is
 one image. For each run the folder gets:
 
@@ -34,24 +34,19 @@ models are deterministic on one machine; only the measured-time columns of the f
 from __future__ import annotations
 
 import csv
-import hashlib
 import io
-import itertools
 import json
 import math
-import os
-import platform
 import shutil
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 import cv2
 import numpy as np
 
-from monopic.cases import GROUND_DEAD_ZONE_MPS, Case
 from monopic.errors import UserError
 from monopic.framelog import FRAME_COLUMNS as FEATURE_COLUMNS
 from monopic.framelog import authors_finite, frame_row
@@ -59,274 +54,25 @@ from monopic.output import atomic_path, write_text_atomically
 from monopic.pipeline import Pipeline
 from monopic.predict.base import Mode
 from monopic.predict.rules import RulePredictor
-from sim.cases import OBLIQUE_RANGE_DEG, place_case
-from sim.coco import SKELETONS, category, encode_mask, mask_box, select_keypoints
-from sim.ground_truth import GroundTruth
-from sim.render import KeptRenderContext
-from sim.scenario import CameraSpec, RobotSpec, Scenario
-from sim.scenario_file import Values
-from sim.sweep import SPEC_KEYS as SWEEP_KEYS
-from sim.sweep import Include, SweepSpec, expand_spec
-from sim.sweep import parse_spec as parse_sweep_spec
-from sim.toml_table import MISSING, FieldError, TomlTable, read_toml
-from sim.world import World
+from sim.dataset.card import readme
+from sim.dataset.coco import SKELETONS, category, encode_mask, mask_box, select_keypoints
+from sim.dataset.spec import FORMAT_VERSION, JPEG_QUALITY, DatasetRun, DatasetSpec, expand
+from sim.runs.sweep import SweepSpec
+from sim.scenario.spec import CameraSpec, Scenario
+from sim.world.ground_truth import GroundTruth
+from sim.world.render import KeptRenderContext
+from sim.world.world import World
 
-FORMAT_VERSION = 1
-JPEG_QUALITY = 90
 # Bytes per frame before any run is measured: JPEG at quality 90 of these renders is about
 # 0.16 byte per pixel; mask, truth line, features row and annotations add a few kB.
 EST_JPEG_BYTES_PER_PIXEL = 0.17
 EST_OTHER_BYTES = 6000
-DEFAULT_LICENCE = "CC-BY-4.0"
-CAMERA_KEYS = ("width", "height", "vertical_fov_deg", "mount_height", "pitch_deg")
-
-
-DOC = "scenarios/datasets/README.md"
-GRID_KEYS = ("name", "description", "licence", "seed", "duration", "fps", "horizon", "camera",
-             "grid")  # fmt: skip
-
-
-@dataclass(frozen=True)
-class Grid:
-    """place_case parameters; the dataset is every combination."""
-
-    cases: tuple[int, ...]
-    distances: tuple[float, ...]
-    lateral_offsets: tuple[float, ...] = (0.0,)
-    pedestrian_speeds: tuple[float, ...] = (1.4,)
-    robot_speeds: tuple[float, ...] = (0.0,)
-    angles: tuple[float, ...] = (45.0,)
-    repeats: int = 1
-
-
-@dataclass(frozen=True)
-class CaseGrid:
-    """The case-grid form's runs: the grid and the settings every one of its runs shares."""
-
-    seed: int
-    duration: float
-    fps: float
-    horizon: float
-    camera: CameraSpec
-    grid: Grid
-
-
-@dataclass(frozen=True)
-class DatasetSpec:
-    """A dataset spec of either form: which runs (`source`) plus the card's metadata."""
-
-    path: Path
-    name: str
-    description: str
-    licence: str
-    source: CaseGrid | SweepSpec  # a case grid, or a sweep spec's runs as `monopic sweep` has them
-    text: str = field(repr=False)  # the file as written, kept in the dataset
-    # Included scenario files (sweep form): their path in the dataset and their text.
-    scenario_files: tuple[tuple[str, str], ...] = ()
-
-    @property
-    def digest(self) -> str:
-        """Names what the runs are made from: the spec and (sweep form) its scenario files."""
-        h = hashlib.sha256(self.text.encode())
-        for name, text in self.scenario_files:
-            h.update(f"\0{name}\0{text}".encode())
-        return h.hexdigest()[:16]
 
 
 # -- the spec file -------------------------------------------------------------------
 
 
-def load_spec(path: Path) -> DatasetSpec:
-    """Read and validate a dataset spec of either form; every mistake names the field.
-
-    The form follows from the keys: [grid] is a case grid, [[include]] a sweep spec.
-    """
-    path = Path(path)
-    text, data = read_toml(path, "dataset spec")
-    if _form(path, data) == "sweep":
-        sweep = parse_sweep_spec(path, data, DOC)
-        licence = sweep.licence or DEFAULT_LICENCE
-        files = _scenario_files(sweep)
-        return DatasetSpec(path, sweep.name, sweep.description, licence, sweep, text, files)
-    top = TomlTable(path, "", data, DOC)
-    name = top.slug("name")
-    description = top.text("description", "")
-    licence = top.text("licence", DEFAULT_LICENCE, nonempty=True)
-    seed = top.integer("seed", 0, low=0, high=2**31 - 1)
-    duration = top.number("duration", 3.0, low=0.2, high=60.0)
-    fps = top.number("fps", 15.0, low=1.0, high=60.0)
-    horizon = top.number("horizon", 1.0, low=0.1, high=10.0)
-    cam_t = top.table("camera")
-    base = CameraSpec()
-    camera = CameraSpec(
-        width=cam_t.integer("width", base.width, low=64, high=4096),
-        height=cam_t.integer("height", base.height, low=64, high=4096),
-        vertical_fov_deg=cam_t.number(
-            "vertical_fov_deg", base.vertical_fov_deg, low=10.0, high=150.0
-        ),
-        mount_height=cam_t.number("mount_height", base.mount_height, low=0.1, high=5.0),
-        pitch_deg=cam_t.number("pitch_deg", base.pitch_deg, low=-45.0, high=45.0),
-    )
-    cam_t.done()
-    g = top.table("grid")
-    cases = g.numbers("cases", low=1, high=9, nonempty=True, distinct=True)
-    if any(c != int(c) for c in cases):
-        raise g.error("cases", list(cases), "case numbers are integers 1-9")
-    lo, hi = OBLIQUE_RANGE_DEG
-    angles = g.numbers("angles", (45.0,), low=lo, high=hi, nonempty=True, distinct=True)
-    for k, a in enumerate(angles):
-        if not lo < a < hi:
-            strictly = f"an oblique angle must lie strictly between {lo:.1f} and {hi:.1f}"
-            raise FieldError(path, f"grid.angles[{k}]", a, strictly)
-
-    def axis(key: str, default: Any, low: float, high: float) -> tuple[float, ...]:
-        return g.numbers(key, default, low=low, high=high, nonempty=True, distinct=True)
-
-    grid = Grid(
-        cases=tuple(int(c) for c in cases),
-        distances=axis("distances", MISSING, -50.0, 50.0),
-        lateral_offsets=axis("lateral_offsets", (0.0,), -20.0, 20.0),
-        pedestrian_speeds=axis("pedestrian_speeds", (1.4,), GROUND_DEAD_ZONE_MPS, 8.0),
-        robot_speeds=axis("robot_speeds", (0.0,), 0.0, 20.0),
-        angles=angles,
-        repeats=g.integer("repeats", 1, low=1, high=1000),
-    )
-    g.done()
-    top.done()
-    source = CaseGrid(seed, duration, fps, horizon, camera, grid)
-    return DatasetSpec(path, name, description, licence, source, text)
-
-
-def _form(path: Path, data: dict[str, Any]) -> str:
-    """'grid' or 'sweep': which form a dataset spec is, by its keys; else a FieldError."""
-    forms = "[grid] (a case grid) or [[include]] (a sweep spec)"
-    if "grid" in data and "include" in data:
-        both = f"a dataset spec has either {forms}, not both; see {DOC}"
-        raise FieldError(path, "grid", data["grid"], both)
-    if "grid" in data:
-        return "grid"
-    if "include" in data:
-        return "sweep"
-    neither = f"a dataset spec needs {forms}"
-    for key, value in data.items():
-        if key not in GRID_KEYS and key not in SWEEP_KEYS:
-            raise FieldError(path, key, value, f"unknown key, and {neither}; see {DOC}")
-    raise FieldError(path, "grid", MISSING, f"missing, and so is include: {neither}; see {DOC}")
-
-
-def _scenario_files(sweep: SweepSpec) -> tuple[tuple[str, str], ...]:
-    """The scenario files a sweep spec includes, named by their path from the spec's folder
-    (leading ../ dropped), with their text: copied into the dataset, part of its digest."""
-    out: dict[str, str] = {}
-    for include in sweep.includes:
-        for file in include.files:
-            rel = Path(os.path.relpath(file, sweep.path.parent))
-            name = "/".join(part for part in rel.parts if part not in ("..", "."))
-            out[name] = file.read_text(encoding="utf-8")
-    return tuple(out.items())
-
-
 # -- runs --------------------------------------------------------------------------------
-
-
-@dataclass(frozen=True)
-class DatasetRun:
-    """One run of the dataset: its id, the parameters it varies and its scenario."""
-
-    index: int
-    id: str
-    params: dict[str, Any]
-    scenario: Scenario
-
-
-def run_seed(spec_seed: int, index: int) -> int:
-    """The world seed of run `index`: independent streams per run, same for the same spec."""
-    return int(np.random.SeedSequence([spec_seed, index]).generate_state(1)[0] >> 1)
-
-
-def expand(spec: DatasetSpec) -> list[DatasetRun]:
-    """Every run of the dataset, in a fixed order (the run ids follow it)."""
-    if isinstance(spec.source, SweepSpec):
-        return _sweep_runs(spec.source)
-    return _grid_runs(spec, spec.source)
-
-
-def _sweep_runs(sweep: SweepSpec) -> list[DatasetRun]:
-    """The runs `monopic sweep` makes of the spec: its ids, scenarios and seeds."""
-    return [
-        DatasetRun(
-            index,
-            run.id,
-            {
-                "family": run.family,
-                "kind": run.kind,
-                "scale": run.scale,
-                "parameters": run.params,
-                "seed": run.scenario.seed,
-            },
-            run.scenario,
-        )
-        for index, run in enumerate(expand_spec(sweep))
-    ]
-
-
-def _grid_runs(spec: DatasetSpec, source: CaseGrid) -> list[DatasetRun]:
-    """Every combination of the grid.
-
-    Axes a case ignores collapse: standing still has no walking speed or angle, only the
-    oblique cases use the angle.
-    """
-    g = source.grid
-    combos: list[dict[str, Any]] = []
-    seen = set()
-    for case_n, dist, lat, pspeed, rspeed, angle in itertools.product(
-        g.cases, g.distances, g.lateral_offsets, g.pedestrian_speeds, g.robot_speeds, g.angles
-    ):
-        case = Case(case_n)
-        if case is Case.STILL:
-            pspeed = 0.0
-        if case.lateral == 0 or case.depth == 0:
-            angle = None
-        key = (case_n, dist, lat, pspeed, rspeed, angle)
-        if key in seen:
-            continue
-        seen.add(key)
-        for rep in range(g.repeats):
-            combos.append(
-                {
-                    "case": case_n,
-                    "distance": dist,
-                    "lateral_offset": lat,
-                    "pedestrian_speed": pspeed,
-                    "robot_speed": rspeed,
-                    "angle_deg": angle,
-                    "repeat": rep,
-                }
-            )
-    runs = []
-    robot = replace(RobotSpec(), camera=source.camera)
-    for index, params in enumerate(combos):
-        run_id = f"r{index:04d}"
-        seed = run_seed(source.seed, index)
-        try:
-            scenario = place_case(
-                Case(params["case"]),
-                distance=params["distance"],
-                lateral_offset=params["lateral_offset"],
-                pedestrian_speed=params["pedestrian_speed"] or 1.4,
-                robot_speed=params["robot_speed"],
-                angle_deg=params["angle_deg"] or 45.0,
-                duration=source.duration,
-                dt=1.0 / source.fps,
-                horizon=source.horizon,
-                robot=robot,
-                seed=seed,
-                name=f"{spec.name}-{run_id}",
-            )
-        except ValueError as err:
-            raise FieldError(spec.path, "grid", params, str(err)) from None
-        runs.append(DatasetRun(index, run_id, {**params, "seed": seed}, scenario))
-    return runs
 
 
 # -- rendering one run -------------------------------------------------------------------
@@ -334,7 +80,7 @@ def _grid_runs(spec: DatasetSpec, source: CaseGrid) -> list[DatasetRun]:
 
 def dataset_pipeline(scenario: Scenario) -> Pipeline:
     """The paper's image-mode pipeline (rule cascade) whose features the CSV holds."""
-    from sim.runner import scenario_pipeline
+    from sim.runs.pipelines import scenario_pipeline
 
     return scenario_pipeline(scenario, [RulePredictor(mode=Mode.IMAGE)])
 
@@ -372,7 +118,7 @@ def render_run(
 ) -> dict[str, Any]:
     """Render one run into `out`; returns (and writes last) its runs/<id>.json record.
 
-    `kept`: a GL context lent from run to run (sim.render), else the run makes its own.
+    `kept`: a GL context lent from run to run (sim.world.render), else the run makes its own.
     """
     scenario = run.scenario
     cam = scenario.robot.camera
@@ -706,143 +452,3 @@ def _runs_csv(spec: DatasetSpec, records: list[dict[str, Any]]) -> str:
 
 def _folder_bytes(out: Path) -> int:
     return sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
-
-
-def readme(spec: DatasetSpec, counts: dict[str, Any]) -> str:
-    """The dataset card."""
-    import mujoco
-
-    if isinstance(spec.source, SweepSpec):
-        what, image_format, runs = _sweep_card(spec, spec.source, counts)
-    else:
-        what, image_format, runs = _grid_card(spec.source)
-    cases = ", ".join(f"{Case(c).label} ({c}): {n}" for c, n in counts["cases"].items())
-    copied = " (the spec is copied to `spec.toml`"
-    copied += ", the scenario files it includes to `scenarios/`)" if spec.scenario_files else ")"
-    keypoints = " / ".join(
-        str(counts[k]) for k in ("keypoints_visible", "keypoints_occluded", "keypoints_outside")
-    )
-    return f"""# {spec.name}: a synthetic pedestrian dataset from the MonoPIC test bed
-
-{spec.description}
-
-## What
-
-{what}
-
-| | |
-| --- | --- |
-| runs | {counts["runs"]} |
-| images | {counts["images"]} ({image_format}) |
-| person annotations (any pixel visible) | {counts["annotations"]} |
-| keypoints in view / occluded / outside the image | {keypoints} |
-| frames where the pipeline found the pose | {counts["pose_found"]} |
-| pipeline feature rows | {counts["feature_rows"]} |
-| runs ending in contact (the run stops there) | {counts["contacts"]} |
-| size (images, masks, truth, features) | {counts["bytes"] / 1e6:.1f} MB |
-
-Frames per ground-truth case (the case of the next second of true motion): {cases}.
-
-## How it was made
-
-`monopic dataset {spec.path.name} --out DIR`{copied}, with
-monopic's simulator (sim/), MuJoCo {mujoco.__version__} rendering headless (EGL), on
-{platform.machine()} / Python {platform.python_version()}. {runs}
-
-Deterministic: the same spec gives the same images, masks, annotations and truth on the
-same software; the features' measured-time columns (`detectMs` … `totalMs`) differ
-between invocations. Resumable: finished runs (`runs/<run>.json`) are skipped.
-
-## Files
-
-- `images/<run>/<frame>.jpg`, `masks/<run>/<frame>.png` (0 background, 255 pedestrian,
-  from MuJoCo's segmentation rendering; other objects hide it as in the image);
-- `annotations/blazepose33.json`, `annotations/coco17.json`: COCO keypoint files (one
-  category, `person`; `file_name` relative to this folder; `bbox` from the mask;
-  `segmentation` as COCO compressed RLE; keypoints `[x, y, v]` in pixels with v = 0
-  outside the image, 1 hidden by another object (a MuJoCo ray test), 2 in view; the body
-  hiding itself is not marked; `amodal_bbox` is the whole body's box clipped to the
-  image). COCO-17 keypoints are BlazePose's landmarks of the same names. Images where
-  no pixel of the person shows have no annotation;
-- `truth/<run>.jsonl`: per frame, the simulator's ground truth (`sim.ground_truth.
-  GroundTruth.to_dict()`: positions in the world and the robot frame, velocities, case,
-  true phi, time to collision, collision, contact, landmark pixels, occlusion);
-- `frames.csv`: one row per image with the main truth columns;
-- `features/<run>.csv`: the pipeline's own output per frame with a pose, in the MonoPIC
-  authors' log columns then ours (as `monopic video --csv` writes), leaving out rows
-  without a velocity yet (a track's first frame); `monopic tree train` and `monopic
-  replay` read these files (their reader takes `occupiedHeights` as a fraction of a
-  432 px high frame);
-- `runs.csv`: the parameters of every run.
-
-## Licence
-
-{spec.licence}. Everything in the images is generated by the test bed (procedural
-textures, the mannequin, the street); no third-party data is included.
-"""
-
-
-def _grid_card(source: CaseGrid) -> tuple[str, str, str]:
-    """The card's parts for a case grid: what, the image format, how the runs were made."""
-    g, cam = source.grid, source.camera
-    what = """Images from the forward camera of a small robot driving a MuJoCo street while a
-mannequin pedestrian walks one of the paper's nine motion cases, with ground truth
-from the simulator."""
-    image_format = f"{cam.width}x{cam.height}, {source.fps:g} fps, JPEG quality {JPEG_QUALITY}"
-    runs = f"""Each run is one
-`sim.cases.place_case` scenario, for every combination of:
-
-- cases {list(g.cases)};
-- distances {list(g.distances)} m ahead, lateral offsets {list(g.lateral_offsets)} m;
-- walking speeds {list(g.pedestrian_speeds)} m/s, robot speeds {list(g.robot_speeds)} m/s;
-- oblique angles {list(g.angles)} deg; {g.repeats} repeat(s).
-
-{source.duration:g} s per run (a run stops at contact), horizon {source.horizon:g} s. Camera:
-{cam.vertical_fov_deg:g} deg vertical field of view, {cam.mount_height:g} m high,
-pitched {cam.pitch_deg:g} deg down. The gait phase of run k comes from seed {source.seed}
-and k; the pipeline is the paper's image mode (rule cascade) on one onnxruntime thread."""
-    return what, image_format, runs
-
-
-def _sweep_card(
-    spec: DatasetSpec, sweep: SweepSpec, counts: dict[str, Any]
-) -> tuple[str, str, str]:
-    """The card's parts for a sweep spec: what, the image formats, how the runs were made."""
-    what = """Images from the forward camera of a robot (small robot or car, as each scenario
-file says) driving a MuJoCo street while a mannequin pedestrian crosses, walks along
-or stops as the scenario families of a sweep spec (Euro NCAP-style collisions, near
-misses, the paper's motion cases) describe, with ground truth from the simulator."""
-    sizes = ", ".join(f"{w}x{h}" for w, h in counts["image_sizes"]) or "none"
-    image_format = f"{sizes}, JPEG quality {JPEG_QUALITY}"
-    includes = "\n".join(f"- {_include_text(spec.path.parent, i)};" for i in sweep.includes)
-    families = ", ".join(f"{name}: {n}" for name, n in counts["families"].items())
-    runs = f"""The runs are those of the sweep
-spec, exactly as `monopic sweep` expands it (the same scenarios and seeds, and the same
-run ids, `<scenario name>/<draw>-<digest of the scenario>`, so run folders nest). It
-includes:
-
-{includes}
-
-Runs per family: {families}.
-
-Each run lasts as its scenario file says (a run stops at contact), with that file's
-frame rate, horizon, camera, road, lighting and pedestrian; the pipeline is the paper's
-image mode (rule cascade) on one onnxruntime thread."""
-    return what, image_format, runs
-
-
-def _include_text(folder: Path, include: Include) -> str:
-    """One [[include]] entry as the card lists it."""
-    files = ", ".join(f"`{os.path.relpath(f, folder)}`" for f in include.files)
-    how = [f"sampling {include.sampling}"]
-    if include.runs is not None:
-        how.append(f"{include.runs} run{'s' if include.runs != 1 else ''} per file")
-    if include.seed is not None:
-        how.append(f"seed {include.seed}")
-    for key, dist in include.parameters.items():
-        if isinstance(dist, Values):
-            how.append(f"{key} in {list(dist.values)}")
-        else:
-            steps = f" in {dist.steps} steps" if dist.steps else ""
-            how.append(f"{key} from {dist.low:g} to {dist.high:g}{steps}")
-    return f"{files}: {', '.join(how)}"

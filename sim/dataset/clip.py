@@ -19,10 +19,11 @@ from pathlib import Path
 import cv2
 
 from monopic.camera import CameraModel
-from sim.mannequin import N_LANDMARKS, MannequinSpec
-from sim.render import SceneRenderer
-from sim.scene import Scene, SceneConfig
-from sim.truth import PedestrianTruth
+from sim.scenario.spec import MannequinSpec
+from sim.world.body import PedestrianTruth
+from sim.world.mannequin import N_LANDMARKS
+from sim.world.render import SceneRenderer
+from sim.world.scene import Scene, SceneConfig
 
 
 @dataclass(frozen=True)

@@ -1,6 +1,6 @@
 """COCO keypoint files: the two skeletons, run-length masks, and a small strict reader.
 
-The synthetic dataset (sim.dataset) writes one COCO keypoints file per skeleton:
+The synthetic dataset (sim.dataset.build) writes one COCO keypoints file per skeleton:
 BlazePose's 33 landmarks and COCO's own 17 (a subset of BlazePose's, mapped by name).
 Masks are COCO's compressed RLE (column-major runs, first run of zeros, counts written
 as pycocotools' `rleToString` does: 6 bits per character, delta against the count two
@@ -173,7 +173,7 @@ class CocoFile:
 
 
 def read_coco(path: Path) -> CocoFile:
-    """Read a keypoints file written by sim.dataset; UserError naming what is wrong."""
+    """Read a keypoints file written by sim.dataset.build; UserError naming what is wrong."""
     path = Path(path)
     try:
         data = json.loads(path.read_text(encoding="utf-8"))

@@ -14,7 +14,8 @@ viewer) whose dynamics are exactly World.step: one world step per simulation fra
 - render modes: "rgb_array" returns the camera frame, "top_down" highway-env's bird's-eye
   view drawn offscreen.
 
-The config key "scenario" holds a sim.scenario.Scenario (default: sim.cases.default_crossing).
+The config key "scenario" holds a sim.scenario.spec.Scenario (default:
+sim.scenario.cases.default_crossing).
 Each reset draws the world's seed (the gait phase) from the env's RNG, so a seeded reset is
 deterministic. Simulation and policy frequency default to 15 Hz.
 
@@ -37,12 +38,10 @@ from highway_env.envs.common.action import ActionType
 from highway_env.envs.common.graphics import EnvViewer
 from highway_env.envs.common.observation import ObservationType
 
-from sim.cases import default_crossing
-from sim.robot import Robot
-from sim.scenario import Scenario
-from sim.world import World, WorldStep
-
-ENV_ID = "monopic/PedestrianCrossing-v0"
+from sim.scenario.cases import default_crossing
+from sim.scenario.spec import Scenario
+from sim.world.robot import Robot
+from sim.world.world import World, WorldStep
 
 
 class CameraObservation(ObservationType):
@@ -105,7 +104,7 @@ class PedestrianCrossingEnv(AbstractEnv):
         config = super().default_config()
         config.update(
             {
-                "scenario": None,  # a Scenario; None: sim.cases.default_crossing()
+                "scenario": None,  # a Scenario; None: sim.scenario.cases.default_crossing()
                 "observation": {"type": "camera"},
                 "action": {"type": "acceleration"},
                 "simulation_frequency": 15,
@@ -227,7 +226,3 @@ class PedestrianCrossingEnv(AbstractEnv):
         if self.world is not None:
             self.world.close()
             self.world = None
-
-
-if ENV_ID not in gymnasium.registry:
-    gymnasium.register(id=ENV_ID, entry_point="sim.env:PedestrianCrossingEnv")

@@ -10,7 +10,7 @@ atan2(vy, vx) (RoadObject.direction), so a positive heading turns from +x toward
 which is clockwise seen from above. In words: x along the road, y to the right of the
 road's direction, heading clockwise from x, when seen from above.
 
-The world frame (sim.frames) is x east, y north, z up, yaw counter-clockwise from east.
+The world frame (sim.geometry.frames) is x east, y north, z up, yaw counter-clockwise from east.
 Both share x; highway-env's y is the world's -y, and its heading the world's -yaw. The
 conversion is a reflection, hence its own inverse: `reflect` is the one function, the
 named wrappers only say which way a call goes.
@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from sim.frames import Pose2D, wrap_angle
+from sim.geometry.frames import Pose2D, wrap_angle
 
 # Position and velocity vectors change by this matrix in either direction.
 REFLECTION = np.array([[1.0, 0.0], [0.0, -1.0]])

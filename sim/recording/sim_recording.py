@@ -8,14 +8,14 @@ really going to happen) reads at a glance. Entities added to RunRecording's:
 - camera/truth/{foot,centre,box,path}: the true foot point, torso centre and apparent box,
   and the true foot path over the next horizon seen by the current camera (the frame the
   ground-mode prediction is drawn in, so the two compare directly);
-- world/...: a 3D view of the ground plane in the world frame of sim.frames (z up):
+- world/...: a 3D view of the ground plane in the world frame of sim.geometry.frames (z up):
   world/road (edges, lanes, zebra crossing, parked cars; static), world/robot (a
   Transform3D per frame; below it, in the robot frame, the body, the camera frustum,
   the swept zone and world/robot/prediction/<predictor>: every ground-mode decision's
   predicted foot point), world/robot_trail, world/pedestrian (the 33 landmarks as a
   skeleton, the footprint), world/truth/{path,future} (the whole true path; the part
   within the horizon);
-- topdown/image: highway-env's top-down view (sim.env.TopDownViewer), every few frames;
+- topdown/image: highway-env's top-down view (sim.envs.crossing.TopDownViewer), every few frames;
 - time series: truth/phi next to features/phi; ttc/truth and ttc/<predictor> (ground mode's
   predicted time to contact); alarm/truth (contact within the horizon) and
   alarm/<predictor> (its warning), 0/1 scalars for tools and, on the same entities, a
@@ -27,7 +27,7 @@ really going to happen) reads at a glance. Entities added to RunRecording's:
 
 `SimRecording` is the per-frame API a runner calls (the sweep can record every run and
 keep only the ones that went wrong: `close()` keeps the file, `abort()` drops it);
-`record_run` runs one scenario through the pipeline and records it.
+sim.runs.record.record_run runs one scenario through the pipeline and records it.
 
 Colours: truth cyan, robot green, pedestrian orange, the pipeline pink, each predictor its
 own (monopic.recording.predictor_colour) in the 3D view and the plots alike. The camera
@@ -38,18 +38,15 @@ toward where robot and pedestrian meet; plots and lanes span the whole run.
 from __future__ import annotations
 
 import math
-import os
-from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from types import SimpleNamespace
 
 import numpy as np
 import rerun as rr
 import rerun.blueprint as rrb
 
 from monopic.closing import WholeOrNothing
-from monopic.pipeline import FrameResult, Pipeline
+from monopic.pipeline import FrameResult
 from monopic.pose.skeleton import CONNECTIONS, LANDMARK_NAMES
 from monopic.predict.base import Mode
 from monopic.recording import (
@@ -63,10 +60,10 @@ from monopic.recording import (
     predictor_colour,
 )
 from monopic.variants.zone import swept_ground_zone
-from sim.ground_truth import GroundTruth
-from sim.runner import make_pipeline, robot_geometry
-from sim.scenario import Scenario
-from sim.world import World, WorldStep
+from sim.recording.topdown import TopDownCamera
+from sim.scenario.spec import Scenario
+from sim.world.ground_truth import GroundTruth, footprint_gap, footprints
+from sim.world.world import World, WorldStep
 
 TRUTH_COLOUR = (0, 210, 255)
 ROBOT_COLOUR = (50, 200, 0)
@@ -109,64 +106,6 @@ def entity_name(predictor: str) -> str:
 
 
 # -- footprints ----------------------------------------------------------------------
-
-
-def rectangle(centre: np.ndarray, yaw: float, length: float, width: float) -> np.ndarray:
-    """Corners (4, 2) of a rectangle on the ground, counter-clockwise."""
-    c, s = math.cos(yaw), math.sin(yaw)
-    half = np.array([[1, 1], [-1, 1], [-1, -1], [1, -1]]) * [length / 2, width / 2]
-    return np.asarray(centre, dtype=float)[:2] + half @ np.array([[c, s], [-s, c]])
-
-
-def footprints(truth: GroundTruth, pedestrian_size: float) -> tuple[np.ndarray, np.ndarray]:
-    """The robot's and the pedestrian's footprints (world frame) at one frame."""
-    r = truth.robot
-    robot = rectangle(r.position, r.yaw, r.length, r.width)
-    ped = rectangle(truth.position_world, truth.heading_world, pedestrian_size, pedestrian_size)
-    return robot, ped
-
-
-def _segment_distance(p: np.ndarray, a: np.ndarray, b: np.ndarray) -> float:
-    ab = b - a
-    t = float(np.clip((p - a) @ ab / max(float(ab @ ab), 1e-18), 0.0, 1.0))
-    return float(np.linalg.norm(p - (a + t * ab)))
-
-
-def _inside(p: np.ndarray, poly: np.ndarray) -> bool:
-    """Point in a convex counter-clockwise polygon (boundary included)."""
-    for a, b in zip(poly, np.roll(poly, -1, axis=0), strict=True):
-        if (b[0] - a[0]) * (p[1] - a[1]) - (b[1] - a[1]) * (p[0] - a[0]) < -1e-12:
-            return False
-    return True
-
-
-def polygon_gap(a: np.ndarray, b: np.ndarray) -> float:
-    """Distance between two convex polygons (counter-clockwise corners), 0 when they overlap."""
-    if any(_inside(p, b) for p in a) or any(_inside(p, a) for p in b):
-        return 0.0
-    gap = math.inf
-    for poly, other in ((a, b), (b, a)):
-        edges = list(zip(other, np.roll(other, -1, axis=0), strict=True))
-        for p in poly:
-            gap = min(gap, min(_segment_distance(p, e0, e1) for e0, e1 in edges))
-    if gap > 0:  # edges crossing without a corner inside: a '+' shaped overlap
-        for p0, p1 in zip(a, np.roll(a, -1, axis=0), strict=True):
-            for q0, q1 in zip(b, np.roll(b, -1, axis=0), strict=True):
-                if _segments_cross(p0, p1, q0, q1):
-                    return 0.0
-    return gap
-
-
-def _segments_cross(p0: np.ndarray, p1: np.ndarray, q0: np.ndarray, q1: np.ndarray) -> bool:
-    def side(a: np.ndarray, b: np.ndarray, c: np.ndarray) -> float:
-        return float((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
-
-    return side(p0, p1, q0) * side(p0, p1, q1) < 0 and side(q0, q1, p0) * side(q0, q1, p1) < 0
-
-
-def footprint_gap(truth: GroundTruth, pedestrian_size: float) -> float:
-    """Metres between the robot's and the pedestrian's footprints (0 in contact)."""
-    return polygon_gap(*footprints(truth, pedestrian_size))
 
 
 # -- the layout ----------------------------------------------------------------------
@@ -276,39 +215,6 @@ def world_eye(start: np.ndarray, yaw: float, meet: np.ndarray) -> rrb.EyeControl
 
 
 # -- highway-env's top-down view -------------------------------------------------------
-
-
-class TopDownCamera:
-    """highway-env's bird's-eye view of a World's road, drawn offscreen.
-
-    sim.env.TopDownViewer wants an environment; it reads only the road, the ego vehicle,
-    the config and the observation type, so a plain namespace carrying the World's own
-    objects stands in for one.
-    """
-
-    def __init__(self, world: World) -> None:
-        from sim.env import PedestrianCrossingEnv, TopDownViewer
-
-        if not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-            os.environ.setdefault("SDL_VIDEODRIVER", "dummy")  # pygame needs a driver
-        self.world = world
-        config = PedestrianCrossingEnv.default_config()
-        # Zoom so the robot is about 30 px long: a 0.8 m robot at the car's 20 px/m was a
-        # 16 px speck on an empty road.
-        config["scaling"] = min(45.0, max(20.0, 30.0 / world.scenario.robot.length))
-        self._host = SimpleNamespace(
-            road=world.road, vehicle=world.robot, config=config, observation_type=None
-        )
-        self._viewer = TopDownViewer(self._host)  # type: ignore[arg-type]
-
-    def render(self) -> np.ndarray:
-        """RGB (H, W, 3) of the current state."""
-        self._host.road, self._host.vehicle = self.world.road, self.world.robot
-        self._viewer.display()
-        return np.ascontiguousarray(self._viewer.get_image())
-
-    def close(self) -> None:
-        self._viewer.close()
 
 
 # -- the recording ---------------------------------------------------------------------
@@ -675,7 +581,7 @@ class SimRecording(WholeOrNothing):
                 rotation=rr.RotationAxisAngle(axis=[0, 0, 1], radians=r.yaw),
             ),
         )
-        zone = swept_ground_zone(robot_geometry(scenario), r.speed, scenario.horizon)
+        zone = swept_ground_zone(scenario.robot.geometry(), r.speed, scenario.horizon)
         closed = np.vstack([zone, zone[:1]])
         rec.log(
             "world/robot/zone",
@@ -821,30 +727,3 @@ class SimRecording(WholeOrNothing):
         if self._topdown is not None:
             self._topdown.close()
             self._topdown = None
-
-
-def record_run(
-    scenario: Scenario,
-    path: Path,
-    *,
-    pipeline: Pipeline | None = None,
-    topdown_every: int = DEFAULT_TOPDOWN_EVERY,
-    stop_at_contact: bool = True,
-    on_frame: Callable[[int], None] | None = None,
-) -> RecordSummary:
-    """Run one scenario through the pipeline, frame by frame, and record it to `path`."""
-    pipeline = pipeline or make_pipeline(scenario)
-    with World(scenario, render=True) as world:
-        recording = SimRecording(path, world, topdown_every=topdown_every)
-        with recording:
-            step = world.reset()
-            for k in range(scenario.frames):
-                if k > 0:
-                    step = world.step()
-                assert step.frame is not None
-                recording.log_step(step, pipeline.process(step.frame))
-                if on_frame is not None:
-                    on_frame(k)
-                if stop_at_contact and step.truth.contact:
-                    break
-        return recording.summary()

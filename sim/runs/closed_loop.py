@@ -1,6 +1,6 @@
 """The closed loop: the robot brakes when the pipeline warns, late by the pipeline's own latency.
 
-Each run steps the gymnasium environment (sim.env, `monopic/PedestrianCrossing-v0`) one
+Each run steps the gymnasium environment (sim.envs.crossing, `monopic/PedestrianCrossing-v0`) one
 frame at a time. A policy turns each frame into a brake decision:
 
 - "none": never brakes (the baseline the contacts are counted against);
@@ -18,7 +18,7 @@ maximum deceleration (RobotSpec.max_deceleration) until it stands, and stays sta
 (an emergency stop, as AEB systems do; a false alarm therefore costs the rest of the run).
 The pipeline processes every frame even when L > dt (a real robot would drop frames).
 
-Per run: contact (footprints meet, sim.ground_truth), the robot's speed at contact
+Per run: contact (footprints meet, sim.world.ground_truth), the robot's speed at contact
 (impact speed), the smallest gap between the footprints, when the first warning came and
 when the brake acted.
 """
@@ -36,11 +36,12 @@ import numpy as np
 
 from monopic.pipeline import Pipeline
 from monopic.predict.base import Mode
-from monopic.predictors import make_predictor
-from sim.env import ENV_ID
-from sim.recording import SimRecording, footprint_gap
-from sim.scenario import Scenario
-from sim.world import World, WorldStep
+from monopic.predict.registry import make_predictor
+from sim.envs import ENV_ID
+from sim.recording.sim_recording import SimRecording
+from sim.scenario.spec import Scenario
+from sim.world.ground_truth import footprint_gap
+from sim.world.world import World, WorldStep
 
 NO_BRAKE = "none"
 ORACLE = "truth"
@@ -114,7 +115,7 @@ class LatencyBrake:
 
 def policy_pipeline(scenario: Scenario, policy: str) -> Pipeline:
     """A pipeline whose primary (only) predictor is the policy's, e.g. 'rules/ground'."""
-    from sim.runner import scenario_pipeline
+    from sim.runs.pipelines import scenario_pipeline
 
     name, _, mode = policy.partition("/")
     if mode not in {m.value for m in Mode}:

@@ -4,7 +4,7 @@ Both call the same `work(spec)` and hand each finished result to the sweep as it
 arrives; results depend only on the RunSpec (its seed included), never on the executor.
 Workers render with their own EGL context (created in the worker: contexts do not
 survive fork, hence spawn) and run onnxruntime with one thread, so N workers use N cores.
-A local worker keeps its GL context from run to run (sim.render.KeptRenderContext: a
+A local worker keeps its GL context from run to run (sim.world.render.KeptRenderContext: a
 fresh one costs about 0.2 s of shader compilation per run on llvmpipe).
 """
 
@@ -23,8 +23,8 @@ from pathlib import Path
 from typing import Any
 
 from monopic.errors import UserError
-from sim.render import KeptRenderContext
-from sim.runner import RunSpec
+from sim.runs.run_spec import RunSpec
+from sim.world.render import KeptRenderContext
 
 # What every worker's environment needs before it imports MuJoCo or numpy.
 WORKER_ENV = {
@@ -42,7 +42,7 @@ def work(spec: RunSpec, kept: KeptRenderContext | None = None) -> dict[str, Any]
 
     `kept`: the worker's GL context, lent to the run.
     """
-    from sim.runner import run
+    from sim.runs.runner import run
 
     try:
         camera = spec.scenario.robot.camera

@@ -19,7 +19,7 @@ from typing import Any
 
 from monopic.closing import Closing
 from monopic.errors import UserError
-from sim.code_version import UNKNOWN
+from sim.runs.code_version import UNKNOWN
 
 
 @dataclass(frozen=True)

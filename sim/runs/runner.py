@@ -17,94 +17,25 @@ import math
 import os
 import platform
 import time
-from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from monopic.pipeline import FrameResult, Pipeline, PipelineConfig
+from monopic.pipeline import FrameResult
 from monopic.pose.region import Region
-from monopic.pose.tracker import TrackerConfig
-from monopic.predict.base import Mode, Predictor
-from monopic.predictors import make_predictor
-from monopic.variants.warning import CollisionWarning
-from monopic.variants.zone import RobotGeometry
-from sim.ground_truth import GroundTruth
-from sim.render import RenderContext
-from sim.scenario import Scenario
-from sim.world import World
+from sim.runs.pipelines import make_pipeline
+from sim.runs.run_spec import RunSpec
+from sim.scenario.spec import Scenario
+from sim.world.ground_truth import GroundTruth
+from sim.world.render import RenderContext
+from sim.world.world import World
 
 SCHEMA = 1
-# The predictors every run compares: the paper's image mode and the ground mode.
-PREDICTORS: tuple[tuple[str, Mode], ...] = (
-    ("rules", Mode.IMAGE),
-    ("tree", Mode.IMAGE),
-    ("constant-velocity", Mode.IMAGE),
-    ("rules", Mode.GROUND),
-    ("constant-velocity", Mode.GROUND),
-)
 STAGES = ("pose", "detect", "landmarks", "features", "predict", "warning", "total")
 HIP_LANDMARKS = (23, 24)
 SHOULDER_LANDMARKS = (11, 12)
-
-
-@dataclass(frozen=True)
-class RunSpec:
-    """Everything a worker needs for one run (plain, picklable data)."""
-
-    id: str
-    scenario: Scenario
-    family: str = ""
-    file: str = ""
-    kind: str = "case"
-    scale: str = "small"
-    params: dict[str, Any] = field(default_factory=dict)
-    sweep: str = ""
-    ablation: bool = True
-    stop_at_contact: bool = True
-    # .rrd recordings: "failed" keeps runs where the primary predictor missed a collision
-    # or raised a false alarm, "all" keeps every run, "none" records nothing.
-    record: str = "none"
-    record_dir: str = ""
-    code: str = ""  # sim.code_version of the code that runs it, written into the result
-
-
-def robot_geometry(scenario: Scenario) -> RobotGeometry:
-    """The pipeline's own footprint: a robot knows its size (reference point = centre)."""
-    robot = scenario.robot
-    return RobotGeometry(width=robot.width, length=robot.length, front=robot.length / 2)
-
-
-def scenario_pipeline(
-    scenario: Scenario, predictors: Sequence[Predictor], tracker: TrackerConfig | None = None
-) -> Pipeline:
-    """A pipeline set up for the scenario: its horizon and the robot's own footprint.
-
-    One onnxruntime thread by default, since workers run side by side.
-    """
-    config = PipelineConfig(
-        horizon=scenario.horizon,
-        mode=predictors[0].mode,
-        tracker=tracker or TrackerConfig(threads=1),
-        warning=CollisionWarning(robot=robot_geometry(scenario)),
-    )
-    return Pipeline(config, predictors)
-
-
-def make_pipeline(scenario: Scenario, ablation: bool = False) -> Pipeline:
-    """All predictors on one pose, the sweep's pipeline.
-
-    The ablation's tracker never detects (a threshold above any score, and no tiles so a
-    failed crop costs one whole-frame pass): it only ever sees the true crop, so what it
-    gets right or wrong is the pose from that crop.
-    """
-    tracker = (
-        TrackerConfig(threads=1, min_detection_score=1.01, acquire_tiles=()) if ablation else None
-    )
-    predictors = [make_predictor(name, mode) for name, mode in PREDICTORS]
-    return scenario_pipeline(scenario, predictors, tracker)
 
 
 def truth_region(truth: GroundTruth) -> Region | None:
@@ -268,7 +199,7 @@ def run(
 ) -> dict[str, Any]:
     """Run one scenario through the pipeline(s); returns its result line (a dict).
 
-    A worker running many scenarios lends each the same `render_context` (sim.render).
+    A worker running many scenarios lends each the same `render_context` (sim.world.render).
     """
     scenario = spec.scenario
     start = time.perf_counter()
@@ -346,7 +277,7 @@ def _start_recording(spec: RunSpec, world: World):
         return None
     if spec.record not in ("failed", "all"):
         raise ValueError(f"record must be none, failed or all, got {spec.record!r}")
-    from sim.recording import SimRecording
+    from sim.recording.sim_recording import SimRecording
 
     path = Path(spec.record_dir or "recordings") / recording_name(spec)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -33,10 +33,10 @@ from typing import Any
 from tqdm import tqdm
 
 from monopic.errors import UserError
-from sim.code_version import code_version
-from sim.results_file import ResultsWriter, scan
-from sim.runner import RunSpec
-from sim.scenario_file import (
+from sim.runs.code_version import code_version
+from sim.runs.results_file import ResultsWriter, scan
+from sim.runs.run_spec import RunSpec
+from sim.scenario.files import (
     ScenarioFile,
     ScenarioFileError,
     Sweep,
@@ -44,7 +44,7 @@ from sim.scenario_file import (
     load,
     parse_parameters,
 )
-from sim.toml_table import TomlTable, read_toml
+from sim.scenario.toml_table import TomlTable, read_toml
 
 INCLUDE_SAMPLING = ("file", "base", "grid", "random")
 SPEC_KEYS = ("name", "description", "ablation", "licence", "include")
@@ -229,7 +229,7 @@ def run_sweep(
     `ablation` overrides the spec's flag; `limit` stops after that many new runs (to
     measure a rate, or to test resuming). `record` ("failed", "all" or "none") says which
     runs keep a .rrd recording in `record_dir` (default: beside the results file).
-    A results file holding runs of other code (sim.code_version) is not resumed: that
+    A results file holding runs of other code (sim.runs.code_version) is not resumed: that
     is an error, or with `restart` the file and its recordings are set aside first.
     """
     code = code_version()

@@ -25,8 +25,7 @@ import math
 from dataclasses import replace
 
 from monopic.cases import GROUND_DEAD_ZONE_MPS, SECTOR_RATIO, Case
-from sim.mannequin import MannequinSpec
-from sim.scenario import PedestrianSpec, RobotSpec, Scenario, SceneSpec
+from sim.scenario.spec import MannequinSpec, PedestrianSpec, RobotSpec, Scenario, SceneSpec
 
 OBLIQUE_RANGE_DEG = (
     math.degrees(math.atan(SECTOR_RATIO)),

@@ -5,7 +5,7 @@ the vehicle strikes them at a chosen point across its width at a chosen time. He
 is solved backwards: from the robot's speed, the impact time and the impact point the
 pedestrian's start position (and, when it would otherwise start too far away, a standing
 delay before it walks) follow exactly, so the ground-truth path meets the robot's
-footprint where the family says. Everything is in the world frame of sim.frames with
+footprint where the family says. Everything is in the world frame of sim.geometry.frames with
 the robot starting at the origin heading east (+x); right-hand traffic, so the nearside
 is the robot's right (-y) and the far side its left (+y).
 
@@ -20,9 +20,15 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from enum import StrEnum
 
-from sim.mannequin import MannequinSpec
-from sim.road import Occluder, RoadLayout
-from sim.scenario import CameraSpec, Leg, PedestrianSpec, RobotSpec
+from sim.scenario.spec import (
+    CameraSpec,
+    Leg,
+    MannequinSpec,
+    Occluder,
+    PedestrianSpec,
+    RoadLayout,
+    RobotSpec,
+)
 
 # Clearance between the pedestrian and the kerb line when it stops or turns there.
 KERB_STOP_GAP = 0.2  # m

@@ -21,8 +21,8 @@ from typing import Any
 import numpy as np
 
 from monopic.cases import Case
-from sim.cases import place_case
-from sim.families import (
+from sim.scenario.cases import place_case
+from sim.scenario.families import (
     BODIES,
     CLOTHING,
     LIGHTING,
@@ -41,10 +41,18 @@ from sim.families import (
     place_longitudinal,
     street_bounds,
 )
-from sim.pedestrian import PedestrianPath
-from sim.road import Occluder, RoadLayout
-from sim.scenario import CameraSpec, Leg, PedestrianSpec, RobotSpec, Scenario, SceneSpec
-from sim.toml_table import MISSING, FieldError, TomlTable, read_toml, show
+from sim.scenario.path import PedestrianPath
+from sim.scenario.spec import (
+    CameraSpec,
+    Leg,
+    Occluder,
+    PedestrianSpec,
+    RoadLayout,
+    RobotSpec,
+    Scenario,
+    SceneSpec,
+)
+from sim.scenario.toml_table import MISSING, FieldError, TomlTable, read_toml, show
 
 KINDS = ("case", "collision", "near-miss")
 PATH_KINDS = ("case", "crossing", "longitudinal", "explicit")
@@ -454,7 +462,7 @@ def _path(
 def _case_path(
     t: TomlTable, robot: RobotSpec, speed: float, looks: Any, footprint: float, duration: float
 ) -> tuple[PedestrianSpec, Case]:
-    """sim.cases.place_case semantics: the path passes (distance, offset) at meet_time."""
+    """sim.scenario.cases.place_case semantics: the path passes (distance, offset) at meet_time."""
     number = t.integer("case", low=1, high=9)
     case = Case(number)
     kwargs = dict(

@@ -3,7 +3,7 @@
 A scenario fully determines a run (with its seed). It is plain data: scenario files
 (scenarios/*.toml) load into it, the eight-case placement builds it from a few
 parameters, and World consumes it. Positions are in the simulator's world frame
-(sim.frames: x east, y north, z up; headings in degrees counter-clockwise from east).
+(sim.geometry.frames: x east, y north, z up; headings in degrees counter-clockwise from east).
 The robot starts at the origin heading east along the road's lane.
 """
 
@@ -14,8 +14,101 @@ from dataclasses import dataclass, field
 
 from monopic.camera import CameraModel
 from monopic.cases import Case
-from sim.mannequin import MannequinSpec
-from sim.road import Occluder, RoadLayout
+from monopic.variants.zone import RobotGeometry
+
+RGB = tuple[float, float, float]
+
+
+@dataclass(frozen=True)
+class RoadLayout:
+    """Geometry of the street; lengths in metres."""
+
+    length: float = 240.0  # along x, centred on x = 0
+    lanes: int = 2
+    lane_width: float = 3.5
+    center_y: float = 0.0
+    pavement_width: float = 3.0
+    crosswalk_x: float | None = 12.0  # centre of the zebra crossing along x, None for none
+    crosswalk_length: float = 4.0  # extent of the crossing along x
+    stripe_width: float = 0.5  # zebra bar width (and gap) across the road
+    line_width: float = 0.12
+    dash_length: float = 3.0
+    dash_gap: float = 6.0
+    buildings: bool = True  # a row of facades behind each pavement
+
+    def __post_init__(self) -> None:
+        if self.lanes < 1 or self.lane_width <= 0 or self.length <= 0:
+            raise ValueError("road needs at least one lane of positive width and length")
+
+    @property
+    def half_width(self) -> float:
+        return self.lanes * self.lane_width / 2
+
+    @property
+    def edges(self) -> tuple[float, float]:
+        """y of the right (south) and left (north) road edges."""
+        return self.center_y - self.half_width, self.center_y + self.half_width
+
+
+@dataclass(frozen=True)
+class Occluder:
+    """A static box on the ground (e.g. a parked car): centre x, y, heading, size (m)."""
+
+    x: float
+    y: float
+    yaw: float = 0.0
+    length: float = 4.5
+    width: float = 1.8
+    height: float = 1.45
+    colour: RGB = (0.55, 0.1, 0.1)
+
+    @classmethod
+    def parked_car(
+        cls, x: float, y: float, yaw: float = 0.0, colour: RGB = (0.55, 0.1, 0.1)
+    ) -> Occluder:
+        """A family-car-sized box."""
+        return cls(x=x, y=y, yaw=yaw, colour=colour)
+
+
+RGBA = tuple[float, float, float, float]
+
+
+@dataclass(frozen=True)
+class MannequinSpec:
+    """What the pedestrian looks like: stature (m) and colours (RGBA in [0, 1])."""
+
+    height: float = 1.8
+    shirt: RGBA = (0.16, 0.32, 0.62, 1.0)
+    trousers: RGBA = (0.18, 0.18, 0.22, 1.0)
+    skin: RGBA = (0.87, 0.68, 0.55, 1.0)
+    hair: RGBA = (0.22, 0.14, 0.08, 1.0)
+    shoes: RGBA = (0.12, 0.11, 0.10, 1.0)
+    long_sleeves: bool = False
+    shirt_pattern: str = "plain"  # "plain" or "checker" (a two-tone check of the shirt)
+
+    def __post_init__(self) -> None:
+        if not 0.8 <= self.height <= 2.2:
+            raise ValueError(f"mannequin height must be in [0.8, 2.2] m, got {self.height}")
+        if self.shirt_pattern not in ("plain", "checker"):
+            raise ValueError(
+                f"shirt_pattern must be 'plain' or 'checker', got {self.shirt_pattern}"
+            )
+
+    @classmethod
+    def adult(cls, **colours: object) -> MannequinSpec:
+        """A 1.8 m adult."""
+        return cls(height=1.8, **colours)  # type: ignore[arg-type]
+
+    @classmethod
+    def child(cls, **colours: object) -> MannequinSpec:
+        """A 1.15 m child (about six years old) in brighter clothes by default."""
+        defaults: dict[str, object] = {
+            "shirt": (0.85, 0.25, 0.2, 1.0),
+            "trousers": (0.2, 0.3, 0.55, 1.0),
+            "hair": (0.25, 0.16, 0.09, 1.0),  # light hair seen from behind passes for a face
+        }
+        defaults.update(colours)
+        return cls(height=1.15, **defaults)  # type: ignore[arg-type]
 
 
 @dataclass(frozen=True)
@@ -53,6 +146,10 @@ class RobotSpec:
     max_deceleration: float = 8.0  # braking, as a positive number
     max_speed: float = 20.0
 
+    def geometry(self) -> RobotGeometry:
+        """The pipeline's own footprint: a robot knows its size (reference point = centre)."""
+        return RobotGeometry(width=self.width, length=self.length, front=self.length / 2)
+
 
 @dataclass(frozen=True)
 class Leg:
@@ -60,7 +157,7 @@ class Leg:
 
     From `at` seconds after the start, walk at `speed` (0: stand still) with the heading
     turned by `turn_deg` (counter-clockwise) relative to the previous leg. The start is
-    the scenario's t = 0 (start_delay does not shift legs; see sim.pedestrian).
+    the scenario's t = 0 (start_delay does not shift legs; see sim.world.pedestrian).
     """
 
     at: float

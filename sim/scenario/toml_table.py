@@ -1,7 +1,7 @@
 """Strict, typed reads from the tables of a TOML file: the one reader of every spec format.
 
-Scenario files (sim.scenario_file), sweep specs (sim.sweep) and dataset specs
-(sim.dataset) are hand-written, so each value is checked where it is read: a getter of
+Scenario files (sim.scenario.files), sweep specs (sim.runs.sweep) and dataset specs
+(sim.dataset.build) are hand-written, so each value is checked where it is read: a getter of
 TomlTable checks the type and the range and knows the dotted field it reads; done()
 rejects the keys nobody asked for (typos). A mistake is one FieldError line,
 `FILE: FIELD = VALUE: REASON`, so a sweep or a dataset never dies hours in on a typo.

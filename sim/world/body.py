@@ -13,7 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from monopic.camera import CameraModel
-from sim.frames import Pose2D
+from sim.geometry.frames import Pose2D
 
 
 @dataclass(frozen=True)

@@ -1,9 +1,9 @@
 """Ground truth per frame: what the simulator knows that the pipeline must find out.
 
 Assembled by World from highway-env's objects (robot, pedestrian path, footprints) and the
-posed MuJoCo mannequin (sim.truth.PedestrianTruth). Conventions:
+posed MuJoCo mannequin (sim.world.body.PedestrianTruth). Conventions:
 
-- world frame as in sim.frames; robot frame as in monopic.camera (x forward, y left),
+- world frame as in sim.geometry.frames; robot frame as in monopic.camera (x forward, y left),
   taken at this frame's robot pose;
 - velocities are the pedestrian's own motion over the ground (not relative to the robot)
   unless named `relative_`;
@@ -37,9 +37,10 @@ from highway_env import utils
 
 from monopic.camera import CameraModel
 from monopic.cases import Case, case_from_ground_velocity
-from sim.frames import Pose2D, wrap_angle
-from sim.pedestrian import Pedestrian
-from sim.truth import PedestrianTruth
+from sim.geometry.frames import Pose2D, wrap_angle
+from sim.geometry.polygons import polygon_gap, rectangle
+from sim.world.body import PedestrianTruth
+from sim.world.pedestrian import Pedestrian
 
 CASE_WINDOW = 1.0  # s of future motion that defines the ground-truth case
 OCCLUSION_TOLERANCE = 0.02  # m: a hit this close before the landmark does not hide it
@@ -311,3 +312,16 @@ def case_label(velocity_world: np.ndarray, robot_yaw: float) -> tuple[Case, np.n
     vx, vy = float(velocity_world[0]), float(velocity_world[1])
     forward, left = c * vx + s * vy, -s * vx + c * vy
     return case_from_ground_velocity(forward, left), np.array([forward, left])
+
+
+def footprints(truth: GroundTruth, pedestrian_size: float) -> tuple[np.ndarray, np.ndarray]:
+    """The robot's and the pedestrian's footprints (world frame) at one frame."""
+    r = truth.robot
+    robot = rectangle(r.position, r.yaw, r.length, r.width)
+    ped = rectangle(truth.position_world, truth.heading_world, pedestrian_size, pedestrian_size)
+    return robot, ped
+
+
+def footprint_gap(truth: GroundTruth, pedestrian_size: float) -> float:
+    """Metres between the robot's and the pedestrian's footprints (0 in contact)."""
+    return polygon_gap(*footprints(truth, pedestrian_size))

@@ -22,10 +22,9 @@ import mujoco
 import numpy as np
 
 from monopic.pose.skeleton import LANDMARK_NAMES
-from sim.frames import yaw_quat
-from sim.gait import JOINT_FIELDS, MannequinPose
-
-RGBA = tuple[float, float, float, float]
+from sim.geometry.frames import yaw_quat
+from sim.scenario.spec import RGBA, MannequinSpec
+from sim.world.gait import JOINT_FIELDS, MannequinPose
 
 # BlazePose's 33 landmarks, indexed as MediaPipe numbers them; left/right are the
 # person's own. One list for the whole project: the pipeline's.
@@ -35,44 +34,6 @@ N_LANDMARKS = len(BLAZEPOSE_NAMES)
 # Geom and site groups: the robot camera shows geom groups 0-2; sites are kept in a
 # hidden group so the landmark markers never show up in a frame.
 SITE_GROUP = 4
-
-
-@dataclass(frozen=True)
-class MannequinSpec:
-    """What the pedestrian looks like: stature (m) and colours (RGBA in [0, 1])."""
-
-    height: float = 1.8
-    shirt: RGBA = (0.16, 0.32, 0.62, 1.0)
-    trousers: RGBA = (0.18, 0.18, 0.22, 1.0)
-    skin: RGBA = (0.87, 0.68, 0.55, 1.0)
-    hair: RGBA = (0.22, 0.14, 0.08, 1.0)
-    shoes: RGBA = (0.12, 0.11, 0.10, 1.0)
-    long_sleeves: bool = False
-    shirt_pattern: str = "plain"  # "plain" or "checker" (a two-tone check of the shirt)
-
-    def __post_init__(self) -> None:
-        if not 0.8 <= self.height <= 2.2:
-            raise ValueError(f"mannequin height must be in [0.8, 2.2] m, got {self.height}")
-        if self.shirt_pattern not in ("plain", "checker"):
-            raise ValueError(
-                f"shirt_pattern must be 'plain' or 'checker', got {self.shirt_pattern}"
-            )
-
-    @classmethod
-    def adult(cls, **colours: object) -> MannequinSpec:
-        """A 1.8 m adult."""
-        return cls(height=1.8, **colours)  # type: ignore[arg-type]
-
-    @classmethod
-    def child(cls, **colours: object) -> MannequinSpec:
-        """A 1.15 m child (about six years old) in brighter clothes by default."""
-        defaults: dict[str, object] = {
-            "shirt": (0.85, 0.25, 0.2, 1.0),
-            "trousers": (0.2, 0.3, 0.55, 1.0),
-            "hair": (0.25, 0.16, 0.09, 1.0),  # light hair seen from behind passes for a face
-        }
-        defaults.update(colours)
-        return cls(height=1.15, **defaults)  # type: ignore[arg-type]
 
 
 @dataclass(frozen=True)

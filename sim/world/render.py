@@ -23,7 +23,7 @@ import mujoco  # noqa: E402
 import numpy as np  # noqa: E402
 
 from monopic.closing import Closing  # noqa: E402
-from sim.scene import Scene  # noqa: E402
+from sim.world.scene import Scene
 
 GLContext = Any  # mujoco's egl/osmesa/glfw GLContext classes share no base class
 

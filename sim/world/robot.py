@@ -19,10 +19,9 @@ from highway_env.road.road import Road, RoadNetwork
 from highway_env.vehicle.kinematics import Vehicle
 from highway_env.vehicle.objects import Obstacle
 
-from sim.frames import Pose2D
-from sim.highway_frame import highway_to_world, world_to_highway
-from sim.road import Occluder, RoadLayout
-from sim.scenario import RobotSpec
+from sim.geometry.frames import Pose2D
+from sim.geometry.highway_frame import highway_to_world, world_to_highway
+from sim.scenario.spec import Occluder, RoadLayout, RobotSpec
 
 ROAD_NODES = ("west", "east")
 EGO_COLOUR = (50, 200, 0)  # highway-env's ego green in its top-down view

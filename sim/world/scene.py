@@ -1,6 +1,6 @@
 """The MuJoCo world: street, sun and sky, a robot carrying the camera, one pedestrian.
 
-Built in code with mujoco.MjSpec. Frames (see sim.frames): world x east, y north, z up,
+Built in code with mujoco.MjSpec. Frames (see sim.geometry.frames): world x east, y north, z up,
 ground at z = 0, headings in radians counter-clockwise from east.
 
 The robot and the pedestrian are placed, not simulated: whoever owns the motion (a
@@ -21,11 +21,12 @@ import mujoco
 import numpy as np
 
 from monopic.camera import CameraModel
-from sim.frames import Pose2D, yaw_quat
-from sim.gait import Gait, MannequinPose
-from sim.mannequin import Mannequin, MannequinSpec, build_mannequin
-from sim.road import Occluder, RoadLayout, build_street
-from sim.truth import PedestrianTruth, make_truth
+from sim.geometry.frames import Pose2D, yaw_quat
+from sim.scenario.spec import MannequinSpec, Occluder, RoadLayout
+from sim.world.body import PedestrianTruth, make_truth
+from sim.world.gait import Gait, MannequinPose
+from sim.world.mannequin import Mannequin, build_mannequin
+from sim.world.street import build_street
 
 PEDESTRIAN_PREFIX = "ped/"
 CAMERA_NAME = "robot/camera"

@@ -10,68 +10,16 @@ markings are thin white boxes, all added to an MjSpec in code.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
 
 import mujoco
 import numpy as np
 
-from sim.frames import yaw_quat
+from sim.geometry.frames import yaw_quat
+from sim.scenario.spec import RGB, Occluder, RoadLayout
 
-RGB = tuple[float, float, float]
 PAINT_HEIGHT = 0.004  # m, top of the road markings above the asphalt
 SLAB_DEPTH = 0.1  # m, thickness of the road and pavement boxes below z = 0
 GROUND_DEPTH = 0.1  # m, thickness of the grass box whose top is 1 cm below the road
-
-
-@dataclass(frozen=True)
-class RoadLayout:
-    """Geometry of the street; lengths in metres."""
-
-    length: float = 240.0  # along x, centred on x = 0
-    lanes: int = 2
-    lane_width: float = 3.5
-    center_y: float = 0.0
-    pavement_width: float = 3.0
-    crosswalk_x: float | None = 12.0  # centre of the zebra crossing along x, None for none
-    crosswalk_length: float = 4.0  # extent of the crossing along x
-    stripe_width: float = 0.5  # zebra bar width (and gap) across the road
-    line_width: float = 0.12
-    dash_length: float = 3.0
-    dash_gap: float = 6.0
-    buildings: bool = True  # a row of facades behind each pavement
-
-    def __post_init__(self) -> None:
-        if self.lanes < 1 or self.lane_width <= 0 or self.length <= 0:
-            raise ValueError("road needs at least one lane of positive width and length")
-
-    @property
-    def half_width(self) -> float:
-        return self.lanes * self.lane_width / 2
-
-    @property
-    def edges(self) -> tuple[float, float]:
-        """y of the right (south) and left (north) road edges."""
-        return self.center_y - self.half_width, self.center_y + self.half_width
-
-
-@dataclass(frozen=True)
-class Occluder:
-    """A static box on the ground (e.g. a parked car): centre x, y, heading, size (m)."""
-
-    x: float
-    y: float
-    yaw: float = 0.0
-    length: float = 4.5
-    width: float = 1.8
-    height: float = 1.45
-    colour: RGB = (0.55, 0.1, 0.1)
-
-    @classmethod
-    def parked_car(
-        cls, x: float, y: float, yaw: float = 0.0, colour: RGB = (0.55, 0.1, 0.1)
-    ) -> Occluder:
-        """A family-car-sized box."""
-        return cls(x=x, y=y, yaw=yaw, colour=colour)
 
 
 def _texture(spec: mujoco.MjSpec, name: str, **kw: object) -> None:

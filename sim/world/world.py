@@ -1,10 +1,10 @@
 """The simulated world: one step advances highway-env, poses MuJoCo, renders, tells the truth.
 
-highway-env owns the motion: the robot is a highway-env vehicle (sim.robot) on a
+highway-env owns the motion: the robot is a highway-env vehicle (sim.world.robot) on a
 highway-env road, the pedestrian a highway-env road object walking its scenario path
-(sim.pedestrian). MuJoCo only shows it: each step puts the camera robot and the
+(sim.world.pedestrian). MuJoCo only shows it: each step puts the camera robot and the
 mannequin where highway-env says, renders the robot camera and reads the mannequin's
-landmarks for the ground truth (sim.ground_truth). The scenario runner, the gymnasium
+landmarks for the ground truth (sim.world.ground_truth). The scenario runner, the gymnasium
 environment and the closed loop all call the same `World.step`.
 
 Rendering: the MuJoCo renderer (an EGL context) is created lazily on the first frame, in
@@ -26,8 +26,10 @@ from highway_env.road.road import Road
 from monopic.camera import CameraModel
 from monopic.closing import Closing
 from monopic.frame import EgoState, Frame
-from sim.frames import Pose2D, wrap_angle
-from sim.ground_truth import (
+from sim.geometry.frames import Pose2D, wrap_angle
+from sim.scenario.path import PathState
+from sim.scenario.spec import Scenario
+from sim.world.ground_truth import (
     CASE_WINDOW,
     TORSO_LANDMARKS,
     GroundTruth,
@@ -39,11 +41,10 @@ from sim.ground_truth import (
     polygons_intersect,
     time_to_contact,
 )
-from sim.pedestrian import PathState, Pedestrian
-from sim.render import Marker, RenderContext, SceneRenderer
-from sim.robot import Robot, highway_road
-from sim.scenario import Scenario
-from sim.scene import Scene, SceneConfig
+from sim.world.pedestrian import Pedestrian
+from sim.world.render import Marker, RenderContext, SceneRenderer
+from sim.world.robot import Robot, highway_road
+from sim.world.scene import Scene, SceneConfig
 
 ROBOT_START = Pose2D(0.0, 0.0, 0.0)  # the world origin, heading east along the road
 TTC_LOOKAHEAD = 10.0  # s: how far ahead the time to collision is searched
@@ -73,7 +74,7 @@ class World(Closing):
         ttc_lookahead: float = TTC_LOOKAHEAD,
         render_context: RenderContext | None = None,
     ) -> None:
-        """`render_context`, when given, is lent to the renderer (sim.render: reusing one
+        """`render_context`, when given, is lent to the renderer (sim.world.render: reusing one
         across worlds saves its shader compilation); otherwise the world makes its own."""
         if not ttc_lookahead >= scenario.horizon:
             raise ValueError("the time-to-collision lookahead must cover the horizon")

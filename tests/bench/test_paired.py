@@ -3,14 +3,15 @@
 from __future__ import annotations
 
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "bench"))
+from tests.paths import ROOT  # noqa: E402
+
+sys.path.insert(0, str(ROOT / "bench"))
 from paired import blocks, paired_median_difference  # noqa: E402
 
 

@@ -4,7 +4,6 @@ and `monopic video` writes a video, a CSV and a recording rerun can read back.""
 import csv
 import subprocess
 import sys
-from pathlib import Path
 
 import cv2
 import numpy as np
@@ -13,9 +12,9 @@ import pytest
 from monopic.pipeline import Pipeline
 from monopic.replay.logs import read_log
 from monopic.video import VideoSource
+from tests.paths import DATA
 from tests.rrd import column, rows_per_entity
 
-DATA = Path(__file__).parent / "data"
 CLIP = DATA / "walk_clip.mp4"
 TRUTH = DATA / "walk_clip_truth.csv"
 

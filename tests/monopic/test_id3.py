@@ -14,7 +14,8 @@ from hypothesis import strategies as st
 
 from monopic.camera import CameraModel
 from monopic.cases import Case
-from monopic.predict.base import Features, GroundFeatures, Mode, extrapolate_image
+from monopic.features.record import Features, GroundFeatures
+from monopic.predict.base import Mode, extrapolate_image
 from monopic.tree.id3 import (
     DecisionTree,
     ID3Params,

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import onnxruntime as ort
 import pytest
@@ -18,8 +16,9 @@ from monopic.pose.landmarks import (
 )
 from monopic.pose.region import Region
 from monopic.pose.sessions import LANDMARK_FILE, model_path
+from tests.paths import DATA
 
-FIXTURE = Path(__file__).parent / "data" / "pose_reference.npz"
+FIXTURE = DATA / "pose_reference.npz"
 SIZE = 256
 CELLS = 64  # heatmap side: one cell is SIZE / CELLS = 4 crop pixels
 CELL = SIZE / CELLS

@@ -12,13 +12,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from functools import cache
-from pathlib import Path
 
 import numpy as np
 import onnxruntime as ort
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
+from tests.paths import ROOT
+
 MODELS = ROOT / "monopic" / "pose" / "models"
 FIXTURE = ROOT / "tests" / "data" / "pose_reference.npz"
 

@@ -10,7 +10,7 @@ import pytest
 
 from monopic.cases import Case
 from monopic.features import orientation
-from monopic.predict.base import Features
+from monopic.features.record import Features
 from monopic.tree.discretise import AuthorsPhiBins, DeadZoneSignBins, authors_discretiser
 from monopic.tree.model import Placement, TrainingSample, TreePredictor, fit_model
 from monopic.tree.opcount import (

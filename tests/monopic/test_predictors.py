@@ -5,8 +5,9 @@ import pytest
 
 from monopic.camera import CameraModel
 from monopic.cases import Case
+from monopic.features.record import Features, GroundFeatures
 from monopic.frame import EgoState
-from monopic.predict.base import Features, GroundFeatures, Mode, extrapolate_image
+from monopic.predict.base import Mode, extrapolate_image
 from monopic.predict.constant_velocity import ConstantVelocityPredictor
 from monopic.predict.rules import RulePredictor, image_rule_case
 from monopic.variants.path import project_path

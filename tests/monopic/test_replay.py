@@ -20,14 +20,15 @@ from monopic.replay.run import AUTHORS, STILL, replay
 from monopic.replay.training import TrainOptions, train_on_logs
 from monopic.tree.model import TrainingSample, fit_model
 from monopic.tree.serialise import DEFAULT_TREE_NAME, dumps, save_model
+from tests.paths import DATA, ROOT
 
-DATA = Path(__file__).parent / "data" / "authors"
+LOGS = DATA / "authors"
 PAPER_FIGURES = {"data0": 0.8764, "data1": 0.7698, "data2": 0.9085, "data3": 0.9157}
 
 
 @pytest.mark.parametrize(("name", "figure"), sorted(PAPER_FIGURES.items()))
 def test_paper_metric_gives_the_authors_figures_exactly(name, figure):
-    log = read_log(DATA / f"{name}.csv")
+    log = read_log(LOGS / f"{name}.csv")
     center = np.column_stack([log.center_x, log.center_y])
     predicted = np.column_stack([log.predicted_x, log.predicted_y])
     assert round(paper_metric(center, predicted), 4) == figure
@@ -103,7 +104,7 @@ def test_horizon_errors_are_euclidean():
 
 
 def _all_logs():
-    return [prepare(read_log(DATA / f"data{k}.csv")) for k in range(4)]
+    return [prepare(read_log(LOGS / f"data{k}.csv")) for k in range(4)]
 
 
 def test_leave_one_file_out_never_trains_on_the_judged_file():
@@ -117,30 +118,30 @@ def test_leave_one_file_out_never_trains_on_the_judged_file():
 
 
 def test_shipped_default_tree_is_reproduced_by_its_documented_command(tmp_path):
-    shipped = Path(__file__).parents[1] / "monopic" / "tree" / DEFAULT_TREE_NAME
+    shipped = ROOT / "monopic" / "tree" / DEFAULT_TREE_NAME
     model = train_on_logs(_all_logs(), TrainOptions())
     assert dumps(model) == shipped.read_text()
     out = tmp_path / "tree.json"
-    args = ["tree", "train", *(str(DATA / f"data{k}.csv") for k in range(4)), "--out", str(out)]
+    args = ["tree", "train", *(str(LOGS / f"data{k}.csv") for k in range(4)), "--out", str(out)]
     assert main(args) == 0
     assert out.read_text() == shipped.read_text()
 
 
 def test_replay_cli_writes_every_row_and_flags_in_sample(tmp_path, capsys):
-    shipped = Path(__file__).parents[1] / "monopic" / "tree" / DEFAULT_TREE_NAME
+    shipped = ROOT / "monopic" / "tree" / DEFAULT_TREE_NAME
     out = tmp_path / "pred.csv"
-    logs = [str(DATA / f"data{k}.csv") for k in (0, 3)]
+    logs = [str(LOGS / f"data{k}.csv") for k in (0, 3)]
     assert main(["replay", *logs, "--tree", str(shipped), "--csv", str(out)]) == 0
     text = capsys.readouterr().out
     assert text.count("IN-SAMPLE") == 2
     assert "overall: 2 files" in text
     with out.open() as fh:
         rows = list(csv.DictReader(fh))
-    n0, n3 = len(read_log(DATA / "data0.csv")), len(read_log(DATA / "data3.csv"))
+    n0, n3 = len(read_log(LOGS / "data0.csv")), len(read_log(LOGS / "data3.csv"))
     assert len(rows) == n0 + n3
     first = rows[0]
     assert (first["file"], first["row"], first["horizon_s"]) == ("data0.csv", "1", "1.0")
-    assert float(first["time"]) == read_log(DATA / "data0.csv").time[0]
+    assert float(first["time"]) == read_log(LOGS / "data0.csv").time[0]
     assert all(math.isfinite(float(r["predicted_x"])) for r in rows)
     assert {int(r["case"]) for r in rows} <= set(range(1, 10))
     assert sorted(p.name for p in tmp_path.iterdir()) == ["pred.csv"]
@@ -201,5 +202,5 @@ def test_replay_refuses_a_ground_tree(tmp_path, capsys):
     ]
     tree = tmp_path / "ground.json"
     save_model(fit_model(samples, mode=Mode.GROUND), tree)
-    assert main(["replay", str(DATA / "data0.csv"), "--tree", str(tree)]) == 2
+    assert main(["replay", str(LOGS / "data0.csv"), "--tree", str(tree)]) == 2
     assert "ground-mode tree" in capsys.readouterr().err

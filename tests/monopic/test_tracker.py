@@ -20,7 +20,7 @@ from monopic.pose.region import Region
 from monopic.pose.search import tile_windows
 from monopic.pose.tracker import PoseTracker, TrackerConfig
 from monopic.video import VideoSource
-from tests.test_end_to_end import CLIP
+from tests.monopic.test_end_to_end import CLIP
 
 
 def small_person_frame(scale: float = 0.2) -> np.ndarray:

@@ -8,8 +8,7 @@ import pytest
 
 from monopic.cases import Case
 from monopic.cli.main import main
-from sim.cases import place_case
-from sim.closed_loop import (
+from sim.runs.closed_loop import (
     NO_BRAKE,
     ORACLE,
     LatencyBrake,
@@ -17,7 +16,8 @@ from sim.closed_loop import (
     run_closed_loop,
     summarise,
 )
-from sim.scenario import CameraSpec, RobotSpec
+from sim.scenario.cases import place_case
+from sim.scenario.spec import CameraSpec, RobotSpec
 
 DT = 1.0 / 15.0
 

@@ -14,7 +14,8 @@ import pytest
 
 from monopic.errors import UserError
 from monopic.replay.logs import read_log
-from sim.coco import (
+from sim.dataset.build import build
+from sim.dataset.coco import (
     COCO17_FROM_BLAZEPOSE,
     COCO17_NAMES,
     decode_mask,
@@ -22,7 +23,7 @@ from sim.coco import (
     read_coco,
     rle_counts,
 )
-from sim.dataset import GRID_KEYS, build, expand, load_spec
+from sim.dataset.spec import GRID_KEYS, expand, load_spec
 
 TINY = """\
 name = "tiny"

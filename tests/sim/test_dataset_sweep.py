@@ -13,16 +13,17 @@ import pytest
 
 from monopic.cli.main import main
 from monopic.errors import UserError
-from sim import sweep
-from sim.dataset import build, expand, load_spec, prepare_folder
-from tests.test_dataset import (
+from sim.dataset.build import build, prepare_folder
+from sim.dataset.spec import expand, load_spec
+from sim.runs import sweep
+from tests.paths import SCENARIOS
+from tests.sim.test_dataset import (
     _without_timing,
     assert_pycocotools_reads_what_our_reader_reads,
     comparable,
 )
 
 SWEEP_KEYS = ", ".join(sorted(sweep.SPEC_KEYS))  # the form detection takes these for a sweep's
-SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
 CASES = SCENARIOS / "cases"
 # Two shipped case files, one random draw each, cut to 0.5 s on a small camera: seconds.
 TINY_SWEEP = f"""\

@@ -9,12 +9,11 @@ import numpy as np
 import pytest
 from gymnasium.utils.env_checker import check_env
 
-import sim.env  # noqa: F401  (registers the environment until sim/__init__ does)
 from monopic.cases import Case
-from sim.cases import default_crossing, place_case
-from sim.env import ENV_ID, PedestrianCrossingEnv
-from sim.road import RoadLayout
-from sim.scenario import CameraSpec, Scenario
+from sim.envs import ENV_ID
+from sim.envs.crossing import PedestrianCrossingEnv
+from sim.scenario.cases import default_crossing, place_case
+from sim.scenario.spec import CameraSpec, RoadLayout, Scenario
 
 SMALL = CameraSpec(width=160, height=90)
 

@@ -9,7 +9,7 @@ from typing import Any
 import pytest
 
 from monopic.cases import Case
-from sim.metrics import (
+from sim.analysis.metrics import (
     available_times,
     case_summary,
     compute,
@@ -18,7 +18,7 @@ from sim.metrics import (
     summarise,
     wilson,
 )
-from sim.report import write_report
+from sim.analysis.report import write_report
 
 DT = 0.1
 KEY = "rules/image"

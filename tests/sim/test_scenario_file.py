@@ -10,11 +10,11 @@ import pytest
 
 from monopic.cases import Case
 from monopic.errors import UserError
-from sim.scenario_file import ScenarioFileError, load
-from sim.sweep import expand_spec, load_spec
-from sim.world import World
+from sim.runs.sweep import expand_spec, load_spec
+from sim.scenario.files import ScenarioFileError, load
+from sim.world.world import World
+from tests.paths import SCENARIOS
 
-SCENARIOS = Path(__file__).resolve().parent.parent / "scenarios"
 SCENARIO_FILES = sorted([*SCENARIOS.glob("cases/*.toml"), *SCENARIOS.glob("families/**/*.toml")])
 
 BASE = """

@@ -4,22 +4,21 @@ from __future__ import annotations
 
 import csv
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-import sim.render
+import sim.world.render
 from monopic.camera import CameraModel
-from sim.clip import ClipSpec, clip_scene, truth_header, truth_row, walk
-from sim.frames import Pose2D
-from sim.gait import JOINT_FIELDS, Gait, idle_pose, pose_vector
-from sim.mannequin import MannequinSpec, geom_z_extent
-from sim.render import GLUnavailableError, Marker, SceneRenderer
-from sim.road import Occluder, RoadLayout
-from sim.scene import Scene, SceneConfig
+from sim.dataset.clip import ClipSpec, clip_scene, truth_header, truth_row, walk
+from sim.geometry.frames import Pose2D
+from sim.scenario.spec import MannequinSpec, Occluder, RoadLayout
+from sim.world.gait import JOINT_FIELDS, Gait, idle_pose, pose_vector
+from sim.world.mannequin import geom_z_extent
+from sim.world.render import GLUnavailableError, Marker, SceneRenderer
+from sim.world.scene import Scene, SceneConfig
+from tests.paths import DATA
 
-DATA = Path(__file__).parent / "data"
 SMALL = CameraModel.from_fov(320, 180, vertical_fov_deg=65.0, mount_height=1.2, pitch_deg=5.0)
 # A pose that is not the identity, so a mix-up of world and robot frames shows.
 ROBOT = Pose2D(3.0, -2.0, 0.7)
@@ -205,13 +204,13 @@ def test_missing_gl_gives_one_clear_error(monkeypatch: pytest.MonkeyPatch) -> No
     def no_gl(width: int, height: int) -> None:
         raise ImportError("libEGL.so.1: cannot open shared object file")
 
-    monkeypatch.setattr(sim.render, "_gl_context", no_gl)
+    monkeypatch.setattr(sim.world.render, "_gl_context", no_gl)
     with pytest.raises(GLUnavailableError, match="libegl1 libgl1-mesa-dri libegl-mesa0"):
         SceneRenderer(small_scene())
 
 
 def test_shipped_clip_truth_matches_the_scene() -> None:
-    """tests/data/walk_clip_truth.csv is what sim.clip computes (no rendering needed)."""
+    """tests/data/walk_clip_truth.csv is what sim.dataset.clip computes (no rendering needed)."""
     clip = ClipSpec()
     scene = clip_scene(clip)
     expected = [truth_row(k, t, scene.truth()) for k, t in walk(clip, scene)]

@@ -16,16 +16,12 @@ from rerun.chunk import RrdReader
 from monopic.cases import Case
 from monopic.cli.main import main
 from monopic.recording import RunRecording, predictor_colour
-from sim.cases import place_case
-from sim.recording import (
-    PREDICTOR_STATES,
-    footprint_gap,
-    polygon_gap,
-    record_run,
-    rectangle,
-    world_eye,
-)
-from sim.world import World
+from sim.geometry.polygons import polygon_gap, rectangle
+from sim.recording.sim_recording import PREDICTOR_STATES, world_eye
+from sim.runs.record import record_run
+from sim.scenario.cases import place_case
+from sim.world.ground_truth import footprint_gap
+from sim.world.world import World
 from tests.rrd import column
 
 

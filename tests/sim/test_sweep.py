@@ -15,12 +15,12 @@ import pytest
 
 from monopic.cli.main import main
 from monopic.errors import UserError
-from sim.code_version import code_version
-from sim.executors import local_executor, ray_executor, ray_runtime_env, work
-from sim.render import KeptRenderContext
-from sim.results_file import ResultsWriter, read_rows, scan
-from sim.runner import deterministic_part
-from sim.sweep import expand_spec, load_spec, run_sweep
+from sim.runs.code_version import code_version
+from sim.runs.executors import local_executor, ray_executor, ray_runtime_env, work
+from sim.runs.results_file import ResultsWriter, read_rows, scan
+from sim.runs.runner import deterministic_part
+from sim.runs.sweep import expand_spec, load_spec, run_sweep
+from sim.world.render import KeptRenderContext
 from tests.rrd import rows_per_entity
 
 # A 6-frame crossing on a 256x144 camera without buildings: seconds per run.

@@ -16,17 +16,25 @@ from hypothesis import strategies as st
 
 from monopic.cases import Case
 from monopic.features.orientation import facing_angle
-from sim.cases import case_heading_deg, default_crossing, place_case
-from sim.frames import Pose2D, wrap_angle
-from sim.ground_truth import contact_window
-from sim.highway_frame import highway_to_world, reflect, world_to_highway
-from sim.mannequin import MannequinSpec
-from sim.pedestrian import PedestrianPath
-from sim.render import Marker, RenderContext
-from sim.road import Occluder, RoadLayout
-from sim.robot import Robot, highway_road
-from sim.scenario import CameraSpec, Leg, PedestrianSpec, RobotSpec, Scenario, SceneSpec
-from sim.world import World
+from sim.geometry.frames import Pose2D, wrap_angle
+from sim.geometry.highway_frame import highway_to_world, reflect, world_to_highway
+from sim.scenario.cases import case_heading_deg, default_crossing, place_case
+from sim.scenario.path import PedestrianPath
+from sim.scenario.spec import (
+    CameraSpec,
+    Leg,
+    MannequinSpec,
+    Occluder,
+    PedestrianSpec,
+    RoadLayout,
+    RobotSpec,
+    Scenario,
+    SceneSpec,
+)
+from sim.world.ground_truth import contact_window
+from sim.world.render import Marker, RenderContext
+from sim.world.robot import Robot, highway_road
+from sim.world.world import World
 
 SMALL_CAMERA = CameraSpec(width=320, height=180)
 LIGHT_SCENE = SceneSpec(road=RoadLayout(buildings=False))

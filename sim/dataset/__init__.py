@@ -1,0 +1,1 @@
+"""Synthetic datasets: specs, runs rendered into images, masks, COCO keypoints; the test clip."""

@@ -1,0 +1,1 @@
+"""Frames and shapes the simulator shares: world and highway-env frames, ground polygons."""

@@ -1,0 +1,1 @@
+"""Rerun recordings of simulated runs: camera, pipeline, truth and world, frame by frame."""

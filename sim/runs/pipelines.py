@@ -1,0 +1,55 @@
+"""The pipelines a run compares, set up as the scenario's robot carries them.
+
+The robot knows its camera, its footprint and the horizon; every predictor runs on one
+pose (image and ground mode side by side).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from monopic.pipeline import Pipeline, PipelineConfig
+from monopic.pose.tracker import TrackerConfig
+from monopic.predict.base import Mode, Predictor
+from monopic.predict.registry import make_predictor
+from monopic.variants.warning import CollisionWarning
+from sim.scenario.spec import Scenario
+
+# The predictors every run compares: the paper's image mode and the ground mode.
+PREDICTORS: tuple[tuple[str, Mode], ...] = (
+    ("rules", Mode.IMAGE),
+    ("tree", Mode.IMAGE),
+    ("constant-velocity", Mode.IMAGE),
+    ("rules", Mode.GROUND),
+    ("constant-velocity", Mode.GROUND),
+)
+
+
+def scenario_pipeline(
+    scenario: Scenario, predictors: Sequence[Predictor], tracker: TrackerConfig | None = None
+) -> Pipeline:
+    """A pipeline set up for the scenario: its horizon and the robot's own footprint.
+
+    One onnxruntime thread by default, since workers run side by side.
+    """
+    config = PipelineConfig(
+        horizon=scenario.horizon,
+        mode=predictors[0].mode,
+        tracker=tracker or TrackerConfig(threads=1),
+        warning=CollisionWarning(robot=scenario.robot.geometry()),
+    )
+    return Pipeline(config, predictors)
+
+
+def make_pipeline(scenario: Scenario, ablation: bool = False) -> Pipeline:
+    """All predictors on one pose, the sweep's pipeline.
+
+    The ablation's tracker never detects (a threshold above any score, and no tiles so a
+    failed crop costs one whole-frame pass): it only ever sees the true crop, so what it
+    gets right or wrong is the pose from that crop.
+    """
+    tracker = (
+        TrackerConfig(threads=1, min_detection_score=1.01, acquire_tiles=()) if ablation else None
+    )
+    predictors = [make_predictor(name, mode) for name, mode in PREDICTORS]
+    return scenario_pipeline(scenario, predictors, tracker)

@@ -1,0 +1,33 @@
+"""What one run is, as a worker receives it: the scenario and what to do with the run.
+
+Plain, picklable data, light to import: sweeps expand specs into these without loading
+the simulator, and executors send them to workers in other processes or on Ray.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any
+
+from sim.scenario.spec import Scenario
+
+
+@dataclass(frozen=True)
+class RunSpec:
+    """Everything a worker needs for one run (plain, picklable data)."""
+
+    id: str
+    scenario: Scenario
+    family: str = ""
+    file: str = ""
+    kind: str = "case"
+    scale: str = "small"
+    params: dict[str, Any] = field(default_factory=dict)
+    sweep: str = ""
+    ablation: bool = True
+    stop_at_contact: bool = True
+    # .rrd recordings: "failed" keeps runs where the primary predictor missed a collision
+    # or raised a false alarm, "all" keeps every run, "none" records nothing.
+    record: str = "none"
+    record_dir: str = ""
+    code: str = ""  # sim.runs.code_version of the code that runs it, written into the result
