@@ -20,7 +20,7 @@ import argparse
 import os
 import sys
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import cv2
@@ -28,6 +28,7 @@ import numpy as np
 
 from monopic.cases import Case
 from monopic.pose.tracker import PoseTracker, TrackerConfig
+from sim.runs.loop import Listener, LoopFrame, StepTimes, run_loop
 from sim.scenario.cases import place_case
 from sim.scenario.spec import CameraSpec, RobotSpec, Scenario
 from sim.world.world import World
@@ -73,6 +74,43 @@ class Tally:
         return f"{100 * self.found / self.frames:.1f} %" if self.frames else "-"
 
 
+@dataclass
+class FoundCounter(Listener):
+    """Runs the tracker on each frame of one clip and counts finds in the true box."""
+
+    tracker: PoseTracker
+    width: int
+    height: int
+    by_bucket: list[Tally]
+    by_case: list[Tally]
+    skipped: int = 0
+    thumb_at: int = -1  # frame to keep a montage thumbnail of
+    thumb_label: str = ""
+    thumbs: list[np.ndarray] = field(default_factory=list)
+
+    def frame(self, frame: LoopFrame) -> None:
+        assert frame.step.frame is not None
+        image, truth = frame.step.frame.image, frame.truth
+        result = self.tracker.process(image)
+        u0, v0, u1, v1 = truth.box
+        if not (u0 >= 0 and v0 >= 0 and u1 <= self.width and v1 <= self.height):
+            self.skipped += 1
+            return
+        found = false = False
+        if result.pose is not None:
+            bx0, by0, bx1, by1 = result.pose.box
+            cx, cy = (bx0 + bx1) / 2, (by0 + by1) / 2
+            found = u0 <= cx <= u1 and v0 <= cy <= v1
+            false = not found
+        b = bucket_of(truth.apparent_height / self.height)
+        for tally in (self.by_bucket[b], self.by_case[b]):
+            tally.frames += 1
+            tally.found += found
+            tally.false += false
+        if frame.index == self.thumb_at:
+            self.thumbs.append(annotate(image, self.thumb_label, truth.box, result))
+
+
 def bucket_of(ratio: float) -> int:
     return next(k for k, (lo, hi) in enumerate(BUCKETS) if lo <= ratio < hi)
 
@@ -108,43 +146,24 @@ def main() -> None:
     tracker = PoseTracker(TrackerConfig())
     by_bucket = [Tally() for _ in BUCKETS]
     by_case = {c.name: [Tally() for _ in BUCKETS] for c in CONFIGS}
-    step_ms: list[float] = []
-    skipped = 0
+    times = StepTimes()
     thumbs: list[np.ndarray] = []
+    montage_distance = min(args.distances, key=lambda d: abs(d - args.montage_distance))
     t_start = time.perf_counter()
+    skipped = 0
     for config in CONFIGS:
         for distance in args.distances:
             tracker.reset()
+            counter = FoundCounter(
+                tracker, args.width, args.height, by_bucket, by_case[config.name]
+            )
+            if args.montage and distance == montage_distance:
+                counter.thumb_at, counter.thumb_label = args.frames // 2, config.name
             with World(clip(config, distance, args.frames, camera)) as world:
-                for k in range(args.frames):
-                    t0 = time.perf_counter()
-                    step = world.reset() if k == 0 else world.step()
-                    step_ms.append((time.perf_counter() - t0) * 1e3)
-                    assert step.frame is not None
-                    image, truth = step.frame.image, step.truth
-                    result = tracker.process(image)
-                    u0, v0, u1, v1 = truth.box
-                    if not (u0 >= 0 and v0 >= 0 and u1 <= args.width and v1 <= args.height):
-                        skipped += 1
-                        continue
-                    found = false = False
-                    if result.pose is not None:
-                        bx0, by0, bx1, by1 = result.pose.box
-                        cx, cy = (bx0 + bx1) / 2, (by0 + by1) / 2
-                        found = u0 <= cx <= u1 and v0 <= cy <= v1
-                        false = not found
-                    b = bucket_of(truth.apparent_height / args.height)
-                    for tally in (by_bucket[b], by_case[config.name][b]):
-                        tally.frames += 1
-                        tally.found += found
-                        tally.false += false
-                    if (
-                        args.montage
-                        and k == args.frames // 2
-                        and distance
-                        == min(args.distances, key=lambda d: abs(d - args.montage_distance))
-                    ):
-                        thumbs.append(annotate(image, config.name, truth.box, result))
+                run_loop(world, (), [times, counter], frames=args.frames, stop_at_contact=False)
+            skipped += counter.skipped
+            thumbs += counter.thumbs
+    step_ms = times.ms
     elapsed = time.perf_counter() - t_start
 
     total = sum(t.frames for t in by_bucket)

@@ -52,19 +52,16 @@ def child_render(frames: int) -> dict[str, Any]:
     """World.step with and without rendering, one core; first frame (GL setup) excluded."""
     import numpy as np
 
+    from sim.runs.loop import StepTimes, run_loop
     from sim.world.world import World
 
     out: dict[str, Any] = {}
     for render in (False, True, False, True):  # alternated, the second pair kept
         sc = scenario(5, frames)
+        times = StepTimes()
         with World(sc, render=render) as world:
-            world.reset()
-            ms = []
-            for _ in range(frames - 1):
-                t0 = time.perf_counter()
-                world.step()
-                ms.append((time.perf_counter() - t0) * 1e3)
-        out["render" if render else "no_render"] = ms
+            run_loop(world, (), [times], frames=frames, stop_at_contact=False)
+        out["render" if render else "no_render"] = times.ms[1:]  # steps, not the reset
     res = {}
     for k, v in out.items():
         a = np.array(v[2:])
@@ -96,7 +93,7 @@ def child_run(frames: int, ablation: bool, shadows: bool = True) -> dict[str, An
             cpu0, t0 = time.process_time(), time.perf_counter()
             result = run(spec, render_context=context)
             wall, cpu = time.perf_counter() - t0, time.process_time() - cpu0
-            results.append({"frames": result["frames"], "wall_s": wall, "cpu_s": cpu})
+            results.append({"frames": result.frames, "wall_s": wall, "cpu_s": cpu})
     return {
         "runs": results,
         "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
