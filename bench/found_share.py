@@ -29,7 +29,7 @@ import numpy as np
 from monopic.cases import Case
 from monopic.pose.tracker import PoseTracker, TrackerConfig
 from sim.runs.loop import Listener, LoopFrame, StepTimes, run_loop
-from sim.scenario.cases import place_case
+from sim.scenario.cases import CasePlacement
 from sim.scenario.spec import CameraSpec, RobotSpec, Scenario
 from sim.world.world import World
 
@@ -117,7 +117,7 @@ def bucket_of(ratio: float) -> int:
 
 def clip(config: Config, distance: float, frames: int, camera: CameraSpec) -> Scenario:
     duration = frames / 15.0
-    sc = place_case(
+    sc = CasePlacement(
         config.case,
         distance=distance,
         robot_speed=0.0,
@@ -125,9 +125,8 @@ def clip(config: Config, distance: float, frames: int, camera: CameraSpec) -> Sc
         facing_deg=config.facing_deg,
         duration=duration,
         meet_time=duration / 2,
-        robot=RobotSpec(camera=camera),
         seed=int(distance * 10),
-    )
+    ).scenario(robot=RobotSpec(camera=camera))
     return replace(sc, name=f"{config.name} @ {distance} m")
 
 

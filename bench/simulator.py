@@ -42,9 +42,9 @@ def scenario(case: int, frames: int, seed: int = 0, shadows: bool = True) -> Any
     from dataclasses import replace
 
     from monopic.cases import Case
-    from sim.scenario.cases import place_case
+    from sim.scenario.cases import CasePlacement
 
-    sc = place_case(Case(case), duration=frames / REALTIME_FPS, seed=seed)
+    sc = CasePlacement(Case(case), duration=frames / REALTIME_FPS, seed=seed).scenario()
     return replace(sc, scene=replace(sc.scene, shadows=shadows))
 
 
@@ -182,7 +182,7 @@ def main() -> None:
     load1 = os.getloadavg()[0]
     r, nr = render["render"], render["no_render"]
     lines = [
-        f"Scenarios: sim.scenario.cases.place_case, 8 m, robot 2 m/s, {args.frames} frames "
+        f"Scenarios: sim.scenario.cases.CasePlacement, 8 m, robot 2 m/s, {args.frames} frames "
         f"at 15 fps, 768x432; child processes with sim.runs.executors.WORKER_ENV; load average "
         f"{load0:.1f} before, {load1:.1f} after, on {os.cpu_count()} cores; "
         f"{time.perf_counter() - start:.0f} s in all.",

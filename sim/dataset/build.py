@@ -1,8 +1,7 @@
 """Synthetic datasets: scenario runs rendered into images, COCO keypoints, masks and truth rows.
 
-A dataset spec (see scenarios/datasets/README.md) is either a case grid ([grid]: every
-combination of sim.scenario.cases.place_case parameters is one run) or a sweep spec ([[include]]:
-the runs sim.runs.sweep expands it into, with the sweep's run ids, scenarios and seeds; the ids
+A dataset spec (see scenarios/datasets/README.md) is a sweep spec: the runs
+sim.runs.sweep expands it into, with the sweep's run ids, scenarios and seeds (the ids
 hold a slash, so the per-run files below nest a folder deeper). Every frame of a run is
 one image. For each run the folder gets:
 
@@ -25,9 +24,8 @@ visible, box from the mask, visibility 0 outside the image, 1 hidden behind anot
 object, 2 in view; RLE masks), frames.csv (one row per image), runs.csv and README.md
 (the card: what, how, counts, licence).
 
-Deterministic for a spec: the run seeds (the gait phase) derive from the spec's seed and
-the run's index (a sweep spec: as the sweep derives them), the renderer and the pose
-models are deterministic on one machine; only the measured-time columns of the features
+Deterministic for a spec: the run seeds (the gait phase) are the sweep's, the renderer
+and the pose models are deterministic on one machine; only the measured-time columns of the features
 (…Ms) differ between invocations.
 """
 
@@ -444,15 +442,13 @@ def _frames_csv(out: Path, records: list[dict[str, Any]]) -> tuple[str, Counter]
     return buf.getvalue(), cases
 
 
-GRID_RUN_COLUMNS = ("case", "distance", "lateral_offset", "pedestrian_speed", "robot_speed",
-                    "angle_deg", "repeat", "seed")  # fmt: skip
 SWEEP_RUN_COLUMNS = ("family", "kind", "scale", "parameters", "seed")  # parameters: JSON
 
 
 def _runs_csv(spec: DatasetSpec, records: list[dict[str, Any]]) -> str:
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    keys = SWEEP_RUN_COLUMNS if isinstance(spec.source, SweepSpec) else GRID_RUN_COLUMNS
+    keys = SWEEP_RUN_COLUMNS
     w.writerow(("run", *keys, "frames", "annotated", "pose_found", "contact_time", "bytes"))
     for r in records:
         p = r["params"]

@@ -8,7 +8,7 @@ import pytest
 
 from monopic.cases import Case
 from sim.runs.loop import Listener, LoopEnd, LoopFrame, OnBoard, StepTimes, run_loop
-from sim.scenario.cases import place_case
+from sim.scenario.cases import CasePlacement
 from sim.world.world import World
 
 
@@ -34,13 +34,15 @@ class Seen(Listener):
 
 def crossing(duration: float = 4.0):
     """Case 5 on a collision course: contact about 2.7 s in (distance = speed x meet time)."""
-    return place_case(Case.PERPENDICULAR_RIGHT, distance=6.0, robot_speed=2.0, meet_time=3.0,
-                      duration=duration)  # fmt: skip
+    placement = CasePlacement(
+        Case.PERPENDICULAR_RIGHT, distance=6.0, robot_speed=2.0, meet_time=3.0, duration=duration
+    )
+    return placement.scenario()
 
 
 def test_frames_end_the_loop_and_listeners_see_each_frame_once_in_order():
     seen, times = Seen(), StepTimes()
-    with World(place_case(Case.AWAY, duration=1.0), render=False) as world:
+    with World(CasePlacement(Case.AWAY, duration=1.0).scenario(), render=False) as world:
         end = run_loop(world, (), [seen, times], frames=5)
     assert seen.calls == ["start", *["frame"] * 5, "end"]
     assert seen.indices == [0, 1, 2, 3, 4]
@@ -62,7 +64,7 @@ def test_contact_ends_the_loop_after_its_frame_unless_told_to_go_on():
 
 def test_until_ends_before_processing_the_state_it_names():
     seen = Seen()
-    with World(place_case(Case.AWAY, duration=2.0), render=False) as world:
+    with World(CasePlacement(Case.AWAY, duration=2.0).scenario(), render=False) as world:
         end = run_loop(world, (), [seen], until=lambda step: step.index >= 3)
     assert seen.indices == [0, 1, 2]
     assert (end.reason, end.frames, end.final.index) == ("until", 3, 3)
@@ -87,7 +89,7 @@ def test_the_controllers_action_drives_the_robot():
 
 
 def test_a_loop_without_an_end_or_a_pipeline_without_frames_is_refused():
-    with World(place_case(Case.AWAY, duration=1.0), render=False) as world:
+    with World(CasePlacement(Case.AWAY, duration=1.0).scenario(), render=False) as world:
         with pytest.raises(ValueError, match="needs an end"):
             run_loop(world, (), [], stop_at_contact=False)
         board = OnBoard("main", pipeline=None)  # type: ignore[arg-type]
