@@ -18,7 +18,9 @@ import pytest
 from tests.paths import ROOT
 
 sys.path.insert(0, str(ROOT / "bench"))
+from goals import GOALS  # noqa: E402
 from history import (  # noqa: E402
+    BENCHMARKS,
     HISTORY,
     SCHEMA,
     BenchRun,
@@ -282,3 +284,19 @@ def test_a_finished_recorder_appends_one_line_and_renders(tmp_path: Path) -> Non
     assert "### Stage after pose" in text and "TABLE" in text
     recorder.finish({}, "NOT WRITTEN", write=False)
     assert len(read(history)) == 1
+
+
+def test_the_committed_benchmarks_md_is_rendered_from_the_committed_history() -> None:
+    expected = render(read(HISTORY), HISTORY)
+    assert BENCHMARKS.read_text(encoding="utf-8") == expected, (
+        "BENCHMARKS.md is not rendered from bench/history.jsonl: run "
+        ".venv/bin/python bench/render.py"
+    )
+
+
+def test_every_goal_finds_its_figure_in_the_committed_history() -> None:
+    # Ties the goals to what the real scripts write (the tests above only write by hand).
+    last = latest(read(HISTORY))
+    for goal in GOALS:
+        assert goal.benchmark in last, f"no {goal.benchmark} run in {HISTORY}"
+        assert goal.read(last[goal.benchmark].results) is not None, goal.text
