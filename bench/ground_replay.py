@@ -49,9 +49,10 @@ from sim.runs.result import MAIN, DecisionColumns, RunResult
 from sim.runs.results_file import read_results
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import append_this_run  # noqa: E402
+from history import Recorder  # noqa: E402
 
 METHOD = "constant-velocity/ground"
+TITLE = "Ground-motion estimators replayed on a sweep's foot points"
 MAX_GAP = 0.5  # s, FeatureExtractor.max_gap: a longer gap restarts the track
 CAR_MOUNT_FORWARD = 0.8  # m, sim.scenario.families' car camera (not in the result line)
 
@@ -143,6 +144,29 @@ class Judged:
     outcomes: list
     errors: np.ndarray
 
+    def record(self) -> dict[str, Any]:
+        """The row's figures as history data (errors in metres)."""
+        sm = summarise(METHOD, self.outcomes)
+        f = sum((o.frames for o in self.outcomes), FrameCounts())
+        near = [o for o in self.outcomes if o.near_miss]
+        e = self.errors
+        return {
+            "estimator": self.name,
+            "agreement_pct": 100 * self.agreement,
+            "collision_runs": sm.collision_runs,
+            "warned_1s": sm.warned_1s,
+            "warned": sm.warned,
+            "near_misses": len(near),
+            "near_misses_warned": sum(o.warned for o in near),
+            "false_alarm_frames": f.fp,
+            "frame_precision": f.tp / max(f.tp + f.fp, 1),
+            "frame_recall": f.tp / max(f.tp + f.fn, 1),
+            "error_p50_m": float(np.percentile(e, 50)),
+            "error_p90_m": float(np.percentile(e, 90)),
+            "error_p99_m": float(np.percentile(e, 99)),
+            "error_over_10m_pct": float(100 * np.mean(e > 10)),
+        }
+
     def row(self) -> str:
         sm = summarise(METHOD, self.outcomes)
         f = sum((o.frames for o in self.outcomes), FrameCounts())
@@ -219,8 +243,9 @@ def main() -> None:
     ap.add_argument("--initial-speed", type=float, nargs="+", default=[])
     ap.add_argument("--pixel-noise-per-height", type=float, nargs="+", default=[])
     ap.add_argument("--plot", type=Path, help="PNG of the error distributions")
-    ap.add_argument("--no-append", action="store_true")
+    ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
+    recorder = Recorder("ground_replay", TITLE)
     rows = load(args.results)
     shipped = GroundTrackConfig()
     candidates: list[tuple[str, Callable[[], Estimator]]] = [
@@ -259,8 +284,13 @@ def main() -> None:
         lines += ["", f"![error distributions]({args.plot})"]
     table = "\n".join(lines)
     print(table)
-    if not args.no_append:
-        append_this_run("Ground-motion estimators replayed on a sweep's foot points", table)
+    results = {
+        "results_file": str(args.results),
+        "runs": len(rows),
+        "method": METHOD,
+        "estimators": [j.record() for j in judged],
+    }
+    recorder.finish(results, table, write=not args.no_append)
 
 
 if __name__ == "__main__":
