@@ -76,13 +76,14 @@ def read_tracks(path: Path) -> TrackSet:
     return TrackSet(path.stem, tuple(tracks))
 
 
-def write_tracks(path: Path, tracks: Sequence[np.ndarray], first_id: int = 1) -> None:
-    """Tracks in the same text format (frame numbers FRAME_STEP apart from 0)."""
+def tracks_text(tracks: Sequence[np.ndarray], first_id: int = 1) -> str:
+    """Tracks in the same text format (frame numbers FRAME_STEP apart from 0, ids from
+    `first_id`), one row per person per step."""
     lines = []
     for i, track in enumerate(tracks):
         for k, (x, y) in enumerate(track):
             lines.append(f"{k * FRAME_STEP:d}\t{first_id + i:d}\t{x:.3f}\t{y:.3f}")
-    path.write_text("\n".join(lines) + ("\n" if lines else ""))
+    return "\n".join(lines) + ("\n" if lines else "")
 
 
 def _heading_change(a: np.ndarray, b: np.ndarray) -> np.ndarray:
@@ -138,3 +139,118 @@ def span(
     (min * (1 - widen), max * (1 + widen))."""
     values = [getattr(s, quantile)[stat] for s in real]
     return min(values) * (1 - widen), max(values) * (1 + widen)
+
+
+# -- the report -----------------------------------------------------------------------
+
+LABELS = {
+    "speed": "speed (m/s)",
+    "abs_acceleration": "|acceleration| (m/s2)",
+    "turn_rate": "turn rate (deg/s)",
+    "cv_error_0.4s": "CV error 0.4 s (m)",
+    "cv_error_0.8s": "CV error 0.8 s (m)",
+    "cv_error_1.2s": "CV error 1.2 s (m)",
+}
+
+
+@dataclass(frozen=True)
+class Verdict:
+    stat: str
+    quantile: str
+    value: float
+    low: float
+    high: float
+
+    @property
+    def inside(self) -> bool:
+        return self.low <= self.value <= self.high
+
+
+def judge(real: Sequence[Summary], simulated: Summary, widen: float = 0.2) -> list[Verdict]:
+    """Each statistic's p50 and p90 of `simulated` against the real scenes' widened span."""
+    out = []
+    for stat, _ in STATISTICS:
+        for quantile in ("p50", "p90"):
+            low, high = span(real, stat, quantile, widen)
+            out.append(Verdict(stat, quantile, getattr(simulated, quantile)[stat], low, high))
+    return out
+
+
+def _g(value: float) -> str:
+    """Three significant digits; rounding noise (a straight walk's 1e-15) as 0."""
+    return "0" if abs(value) < 1e-9 else f"{value:.3g}"
+
+
+def report_text(real: Sequence[Summary], simulated: Sequence[Summary], judged: str,
+                command: str, plot: str) -> str:  # fmt: skip
+    """The realism report (Markdown): a table of every set, the verdicts, the plot."""
+    head = ["set", "tracks", "steps"] + [f"{LABELS[s]} p50 / p90" for s, _ in STATISTICS]
+    lines = [
+        "# Realism: simulated walkers beside real ones",
+        "",
+        f"`{command}`",
+        "",
+        "Statistics of 0.4 s steps (sim/analysis/realism.py): speed, |acceleration| and "
+        f"turn rate over steps where the walker walks (> {WALKING} m/s), and the error of "
+        "holding the last step's velocity for 0.4, 0.8 and 1.2 s; p50 / p90. Real scenes "
+        "are read from their files at run time; simulated tracks are each run's pedestrian "
+        "over the run, exactly as rendered (`monopic tracks`).",
+        "",
+        "| " + " | ".join(head) + " |",
+        "|" + " --- |" * len(head),
+    ]
+    for kind, sets in (("real", real), ("simulated", simulated)):
+        for s in sets:
+            cells = [f"{s.name} ({kind})", str(s.tracks), str(s.steps)]
+            cells += [f"{_g(s.p50[k])} / {_g(s.p90[k])}" for k, _ in STATISTICS]
+            lines.append("| " + " | ".join(cells) + " |")
+    chosen = next((s for s in simulated if s.name == judged), None)
+    if chosen is not None:
+        verdicts = judge(real, chosen)
+        inside = sum(v.inside for v in verdicts)
+        lines += [
+            "",
+            f"## `{judged}` against the real scenes' span",
+            "",
+            "The span of each statistic is the real scenes' min to max, widened by 20 % "
+            "(min x 0.8 to max x 1.2).",
+            "",
+            f"{inside} of {len(verdicts)} inside.",
+            "",
+            "| statistic | quantile | simulated | span | inside |",
+            "| --- | --- | ---: | --- | --- |",
+        ]
+        lines += [
+            f"| {LABELS[v.stat]} | {v.quantile} | {_g(v.value)} | {_g(v.low)} - {_g(v.high)} "
+            f"| {'yes' if v.inside else 'no'} |"
+            for v in verdicts
+        ]
+    lines += ["", f"![distributions]({plot})", ""]
+    return "\n".join(lines)
+
+
+def plot_distributions(real: Sequence[Summary], simulated: Sequence[Summary], path: Path,
+                       title: str) -> None:  # fmt: skip
+    """One panel per statistic: the share of steps within each value, every set a curve."""
+    from matplotlib.figure import Figure
+
+    from monopic.output import atomic_path
+
+    fig = Figure(figsize=(13, 7.5), layout="constrained")
+    for i, (stat, _) in enumerate(STATISTICS):
+        ax = fig.add_subplot(2, 3, i + 1)
+        for s, style in [(s, "-") for s in real] + [(s, "--") for s in simulated]:
+            v = np.sort(s.values[stat])
+            if len(v):
+                ax.plot(v, np.arange(1, len(v) + 1) / len(v), style, label=s.name, lw=1.4)
+        ax.set_xlabel(LABELS[stat])
+        ax.set_ylabel("share of steps within")
+        ax.grid(alpha=0.3)
+        high = max((np.percentile(s.values[stat], 98) for s in (*real, *simulated)
+                    if len(s.values[stat])), default=1.0)  # fmt: skip
+        ax.set_xlim(0, high * 1.1 if high > 0 else 1.0)
+        if i == 0:
+            ax.legend(fontsize=7, loc="lower right")
+    fig.suptitle(title + " (solid: real scenes, dashed: simulated)", fontsize=10)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=100, format="png")
