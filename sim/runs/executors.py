@@ -6,6 +6,11 @@ Workers render with their own EGL context (created in the worker: contexts do no
 survive fork, hence spawn) and run onnxruntime with one thread, so N workers use N cores.
 A local worker keeps its GL context from run to run (sim.world.render.KeptRenderContext: a
 fresh one costs about 0.2 s of shader compilation per run on llvmpipe).
+
+Stopping is bounded: a stopped sweep (Ctrl-C, SIGTERM, an error) sends its workers
+SIGTERM, gives them STOP_GRACE_S to exit and then SIGKILLs the rest; a worker that dies
+mid-run (killed, out of memory) has its run given once more to a fresh worker and, if
+that dies too, reported as failed while the sweep goes on.
 """
 
 from __future__ import annotations
@@ -13,12 +18,16 @@ from __future__ import annotations
 import contextlib
 import multiprocessing
 import os
-import queue
 import signal
+import time
 import traceback
+from collections import Counter, deque
 from collections.abc import Callable, Iterator, Sequence
+from dataclasses import dataclass
+from multiprocessing.connection import Connection
+from multiprocessing.connection import wait as wait_for_any
+from multiprocessing.context import SpawnContext
 from multiprocessing.process import BaseProcess
-from multiprocessing.queues import Queue
 from pathlib import Path
 from typing import Any
 
@@ -33,8 +42,16 @@ WORKER_ENV = {
     "OPENBLAS_NUM_THREADS": "1",
     "MKL_NUM_THREADS": "1",
     "LP_NUM_THREADS": "1",  # Mesa's software rasteriser: one thread per worker
+    # pygame (highway-env) initialises SDL, which catches SIGTERM while it is up and only
+    # queues a quit event: a worker stopped then would run on. Keep SIGTERM fatal.
+    "SDL_NO_SIGNAL_HANDLERS": "1",
 }
 RAY_PIN = "2.60.0"
+STOP_SIGNALS = frozenset({signal.SIGINT, signal.SIGTERM})
+STOP_GRACE_S = 3.0  # a worker told to stop gets this long before SIGKILL
+RERUNS = 1  # times a run whose worker died is given to a fresh worker before it counts as failed
+
+RunFunction = Callable[[RunSpec, KeptRenderContext | None], dict[str, Any]]
 
 
 def work(spec: RunSpec, kept: KeptRenderContext | None = None) -> dict[str, Any]:
@@ -52,28 +69,35 @@ def work(spec: RunSpec, kept: KeptRenderContext | None = None) -> dict[str, Any]
         return {"id": spec.id, "error": traceback.format_exc()}
 
 
-def _worker(tasks: Queue, results: Queue) -> None:
-    """A local worker process: runs specs from `tasks` until None; Ctrl-C is the parent's.
+def _worker(conn: Connection, run: RunFunction) -> None:
+    """A local worker process: runs each spec the parent sends, until None or the parent is gone.
 
+    It starts with SIGINT and SIGTERM blocked (the parent blocks them while it spawns):
+    Ctrl-C is the parent's (a terminal sends it to the whole process group), so a pending
+    one is dropped here; a SIGTERM that came during start-up ends the worker on unblocking.
     If the parent dies without stopping it (kill -9, out of memory), the worker notices
     between runs and exits instead of running the rest of the sweep for nobody.
     """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
+    signal.signal(signal.SIGTERM, signal.SIG_DFL)
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
     parent = multiprocessing.parent_process()
     with KeptRenderContext() as kept:
-        while (spec := _next_task(tasks, parent)) is not None:
-            results.put(work(spec, kept))
-    if parent is not None and not parent.is_alive():
-        results.cancel_join_thread()  # nobody will read what is still queued
+        while (spec := _next_task(conn, parent)) is not None:
+            try:
+                conn.send(run(spec, kept))
+            except OSError:  # the parent is gone (BrokenPipeError) or stopped reading
+                return
 
 
-def _next_task(tasks: Queue, parent: BaseProcess | None) -> RunSpec | None:
+def _next_task(conn: Connection, parent: BaseProcess | None) -> RunSpec | None:
     """The next spec, or None at the stop sign or once the parent is gone."""
     while parent is None or parent.is_alive():
         try:
-            return tasks.get(timeout=1.0)
-        except queue.Empty:
-            continue
+            if conn.poll(1.0):
+                return conn.recv()
+        except (EOFError, OSError):
+            return None
     return None
 
 
@@ -95,52 +119,161 @@ def _environment(env: dict[str, str]) -> Iterator[None]:
                 os.environ[key] = value
 
 
-def _next_result(results: Queue, workers: list[BaseProcess]) -> dict[str, Any]:
-    while True:
-        try:
-            return results.get(timeout=1.0)
-        except queue.Empty:
-            if not any(w.is_alive() for w in workers):
-                codes = ", ".join(str(w.exitcode) for w in workers)
-                raise RuntimeError(
-                    f"every sweep worker exited before its runs were done (exit codes {codes}); "
-                    "rerun the sweep to resume"
-                ) from None
+@contextlib.contextmanager
+def _stop_signals_deferred() -> Iterator[None]:
+    """SIGINT and SIGTERM held back while workers spawn, delivered on leaving.
+
+    A stop that lands inside Process.start() would leave a started worker the sweep does
+    not know about; held back, it is raised once every worker is on the list to stop.
+    The children inherit the blocked mask; _worker unblocks it.
+    """
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
-def local_executor(workers: int | None = None) -> Callable[..., None]:
-    """Spawned processes on this machine (default: one per core)."""
+@dataclass
+class _Slot:
+    """One local worker process, its end of the pipe, and the run it is doing."""
+
+    proc: BaseProcess
+    conn: Connection
+    spec: RunSpec | None = None
+
+    def give(self, spec: RunSpec | None) -> None:
+        """Send the next spec (None: the stop sign); a dead worker is found by its sentinel."""
+        self.spec = spec
+        with contextlib.suppress(OSError):
+            self.conn.send(spec)
+
+
+def _start_worker(ctx: SpawnContext, run: RunFunction) -> _Slot:
+    ours, theirs = ctx.Pipe()
+    proc = ctx.Process(target=_worker, args=(theirs, run), daemon=True)
+    with _environment(WORKER_ENV):
+        proc.start()
+    theirs.close()
+    return _Slot(proc, ours)
+
+
+def _died(proc: BaseProcess) -> str:
+    code = proc.exitcode
+    if code is not None and code < 0:
+        return f"killed by {signal.Signals(-code).name}"
+    return f"exit code {code}"
+
+
+def _stop_workers(slots: list[_Slot], grace: float, finished: bool) -> None:
+    """End every worker within a few `grace` periods: SIGTERM, then SIGKILL for the stubborn.
+
+    `finished`: every worker got its stop sign and is first given `grace` to exit by
+    itself; otherwise (a stop or an error) they are terminated at once.
+    """
+    if finished:
+        _join(slots, grace)
+    for stop in (BaseProcess.terminate, BaseProcess.kill):
+        for slot in slots:
+            if slot.proc.is_alive():
+                stop(slot.proc)
+        _join(slots, grace)
+    for slot in slots:
+        slot.conn.close()
+
+
+def _join(slots: list[_Slot], seconds: float) -> None:
+    deadline = time.monotonic() + seconds
+    for slot in slots:
+        slot.proc.join(max(0.0, deadline - time.monotonic()))
+
+
+def _kill_workers(slots: list[_Slot]) -> None:
+    """A second stop while stopping: no more grace."""
+    for slot in slots:
+        with contextlib.suppress(Exception):
+            if slot.proc.is_alive():
+                slot.proc.kill()
+    for slot in slots:
+        with contextlib.suppress(Exception):
+            slot.proc.join(5.0)
+
+
+def local_executor(
+    workers: int | None = None, run: RunFunction = work, grace: float = STOP_GRACE_S
+) -> Callable[..., None]:
+    """Spawned processes on this machine (default: one per core).
+
+    `run` is what a worker calls per spec (a module-level function: it is pickled by name;
+    tests pass one that misbehaves); `grace` is how long a stopped worker has to exit
+    before it is killed.
+    """
     count = workers or os.cpu_count() or 1
 
     def execute(specs: Sequence[RunSpec], on_result: Callable[[dict[str, Any]], None]) -> None:
         if not specs:
             return
         ctx = multiprocessing.get_context("spawn")
-        tasks: Queue = ctx.Queue()
-        results: Queue = ctx.Queue()
-        procs = [
-            ctx.Process(target=_worker, args=(tasks, results), daemon=True)
-            for _ in range(min(count, len(specs)))
-        ]
-        for spec in specs:
-            tasks.put(spec)
-        for _ in procs:
-            tasks.put(None)  # one stop sign per worker, after the runs
+        todo = deque(specs)
+        deaths: Counter[str] = Counter()
+        slots: list[_Slot] = []
+        finished = False
         try:
-            with _environment(WORKER_ENV):
-                for proc in procs:
-                    proc.start()
-            for _ in specs:
-                on_result(_next_result(results, procs))
-        except BaseException:
-            for proc in procs:
-                proc.terminate()
-            raise
+            with _stop_signals_deferred():
+                for _ in range(min(count, len(specs))):
+                    slots.append(_start_worker(ctx, run))
+            for slot in slots:
+                slot.give(todo.popleft() if todo else None)
+            while any(s.spec is not None for s in slots):
+                busy = [s for s in slots if s.spec is not None]
+                wait_for_any([s.conn for s in busy] + [s.proc.sentinel for s in busy], 1.0)
+                for slot in busy:
+                    result = _result(slot)
+                    if result is not None:
+                        on_result(result)
+                        slot.give(todo.popleft() if todo else None)
+                    elif not slot.proc.is_alive():
+                        lost = slot.spec
+                        assert lost is not None
+                        deaths[lost.id] += 1
+                        slot.spec = None
+                        slot.proc.join()
+                        if deaths[lost.id] <= RERUNS:
+                            todo.appendleft(lost)
+                        else:
+                            on_result(
+                                {
+                                    "id": lost.id,
+                                    "error": f"its worker process died during the run "
+                                    f"{deaths[lost.id]} times (last: {_died(slot.proc)})",
+                                }
+                            )
+                        slots.remove(slot)
+                        slot.conn.close()
+                        if todo:
+                            with _stop_signals_deferred():
+                                fresh = _start_worker(ctx, run)
+                                slots.append(fresh)
+                            fresh.give(todo.popleft())
+            finished = True
         finally:
-            for proc in procs:
-                proc.join()
+            try:
+                _stop_workers(slots, grace, finished)
+            except BaseException:
+                _kill_workers(slots)
+                raise
 
     return execute
+
+
+def _result(slot: _Slot) -> dict[str, Any] | None:
+    """The worker's result if one has come, else None (not yet, or the worker is gone)."""
+    try:
+        if slot.conn.poll():
+            return slot.conn.recv()
+    except (EOFError, OSError):
+        pass
+    return None
 
 
 def ray_runtime_env(upload_code: bool = True) -> dict[str, Any]:
