@@ -19,6 +19,7 @@ import contextlib
 import multiprocessing
 import os
 import signal
+import socket
 import time
 import traceback
 from collections import Counter, deque
@@ -295,11 +296,42 @@ def ray_runtime_env(upload_code: bool = True) -> dict[str, Any]:
     return env
 
 
+# How long joining a cluster may take. Ray's own defaults retry an address that does not
+# answer for over ten minutes, deaf to Ctrl-C for 30 s at a time; a value already in the
+# environment wins.
+RAY_CONNECT_TIMEOUT_S = 5.0
+RAY_CONNECT_ENV = {
+    "RAY_gcs_rpc_server_connect_timeout_s": "3",  # one gRPC connection attempt
+    "RAY_py_gcs_connect_timeout_s": "3",  # the driver's wait for the cluster's id
+    "RAY_gcs_server_port_wait_time_s": "1",  # attempts of the two above
+}
+
+
+def _probe(address: str, timeout: float = RAY_CONNECT_TIMEOUT_S) -> None:
+    """A UserError at once if nothing accepts a TCP connection at a host:port address.
+
+    Names like "auto" or "local" (Ray's own) and unparsable ones are left to Ray.
+    """
+    host, sep, port = address.removeprefix("ray://").rpartition(":")
+    host = host.strip("[]")
+    if not sep or not host or not port.isdigit():
+        return
+    try:
+        with socket.create_connection((host, int(port)), timeout=timeout):
+            pass
+    except OSError as err:
+        reason = "no answer" if isinstance(err, TimeoutError) else (err.strerror or str(err))
+        raise UserError(
+            f"--address {address}: no Ray cluster answers there ({reason} within "
+            f"{timeout:g} s); give the head node's address as `ray start --head` printed it"
+        ) from None
+
+
 def ray_executor(address: str | None, upload_code: bool = True) -> Callable[..., None]:
     """Runs as Ray tasks (one CPU each) on the cluster at `address` (None: RAY_ADDRESS or local).
 
     If this process already called ray.init (e.g. a test's local instance), that
-    connection is used as it is.
+    connection is used as it is. Joining takes at most a few RAY_CONNECT_TIMEOUT_S.
     """
 
     def execute(specs: Sequence[RunSpec], on_result: Callable[[dict[str, Any]], None]) -> None:
@@ -311,25 +343,38 @@ def ray_executor(address: str | None, upload_code: bool = True) -> Callable[...,
                 "(or the project's [ray] extra)"
             ) from None
         if not ray.is_initialized():
+            if address:
+                _probe(address)
+            # ray.init makes SIGTERM exit the process at once (sys.exit): keep ours, so a
+            # stopped sweep cancels its tasks and says so.
+            sigterm = signal.getsignal(signal.SIGTERM)
+            unset = {k: v for k, v in RAY_CONNECT_ENV.items() if k not in os.environ}
             try:
                 # Joining a cluster takes its settings; a local instance gets no dashboard.
                 extra = {} if address else {"include_dashboard": False}
-                ray.init(
-                    address=address,
-                    runtime_env=ray_runtime_env(upload_code),
-                    log_to_driver=False,
-                    **extra,
-                )
-            except ConnectionError as err:
+                with _environment(unset):
+                    ray.init(
+                        address=address,
+                        runtime_env=ray_runtime_env(upload_code),
+                        log_to_driver=False,
+                        **extra,
+                    )
+            except (ConnectionError, TimeoutError) as err:
                 raise UserError(
                     f"--address {address}: cannot reach a Ray cluster ({err})"
                 ) from None
+            finally:
+                if sigterm is not None:
+                    with contextlib.suppress(ValueError):  # not the main thread
+                        signal.signal(signal.SIGTERM, sigterm)
         remote = ray.remote(num_cpus=1)(work)
         pending = [remote.remote(spec) for spec in specs]
         try:
             while pending:
-                done, pending = ray.wait(pending, num_returns=1)
-                on_result(ray.get(done[0]))
+                # A timeout keeps the main thread answering signals between checks.
+                done, pending = ray.wait(pending, num_returns=1, timeout=1.0)
+                for ref in done:
+                    on_result(ray.get(ref))
         except BaseException:
             for ref in pending:
                 ray.cancel(ref, force=True)
