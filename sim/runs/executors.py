@@ -320,11 +320,49 @@ def _probe(address: str, timeout: float = RAY_CONNECT_TIMEOUT_S) -> None:
         with socket.create_connection((host, int(port)), timeout=timeout):
             pass
     except OSError as err:
-        reason = "no answer" if isinstance(err, TimeoutError) else (err.strerror or str(err))
+        reason = (
+            f"no answer within {timeout:g} s"
+            if isinstance(err, TimeoutError)
+            else (err.strerror or str(err)).lower()
+        )
         raise UserError(
-            f"--address {address}: no Ray cluster answers there ({reason} within "
-            f"{timeout:g} s); give the head node's address as `ray start --head` printed it"
+            f"--address {address}: no Ray cluster answers there ({reason}); give the head "
+            "node's address as `ray start --head` printed it"
         ) from None
+
+
+def _connect(ray: Any, address: str | None, upload_code: bool) -> None:
+    """ray.init, bounded in time, keeping this process's SIGTERM handler.
+
+    ray.init makes SIGTERM exit the process at once (sys.exit(15)): ours is put back, so
+    a stopped sweep cancels its tasks and says so. While ray.init waits inside Ray's C++
+    code (at most about 3 x 3 s with RAY_CONNECT_ENV) no Python handler runs.
+    """
+    if address:
+        _probe(address)
+    sigterm = signal.getsignal(signal.SIGTERM)
+    try:
+        # Joining a cluster takes its settings; a local instance gets no dashboard.
+        extra = {} if address else {"include_dashboard": False}
+        ray.init(
+            address=address,
+            runtime_env=ray_runtime_env(upload_code),
+            log_to_driver=False,
+            **extra,
+        )
+    except (ConnectionError, TimeoutError) as err:
+        raise UserError(f"--address {address}: cannot reach a Ray cluster ({err})") from None
+    except SystemExit as exit_:
+        if exit_.code != signal.SIGTERM or sigterm is None:
+            raise
+        # A SIGTERM while joining met Ray's handler: answer it with ours instead.
+        signal.signal(signal.SIGTERM, sigterm)
+        signal.raise_signal(signal.SIGTERM)
+        raise
+    finally:
+        if sigterm is not None:
+            with contextlib.suppress(ValueError):  # not the main thread
+                signal.signal(signal.SIGTERM, sigterm)
 
 
 def ray_executor(address: str | None, upload_code: bool = True) -> Callable[..., None]:
@@ -335,38 +373,20 @@ def ray_executor(address: str | None, upload_code: bool = True) -> Callable[...,
     """
 
     def execute(specs: Sequence[RunSpec], on_result: Callable[[dict[str, Any]], None]) -> None:
-        try:
-            import ray
-        except ImportError:
-            raise UserError(
-                f"--executor ray needs Ray: pip install 'ray[default]=={RAY_PIN}' "
-                "(or the project's [ray] extra)"
-            ) from None
-        if not ray.is_initialized():
-            if address:
-                _probe(address)
-            # ray.init makes SIGTERM exit the process at once (sys.exit): keep ours, so a
-            # stopped sweep cancels its tasks and says so.
-            sigterm = signal.getsignal(signal.SIGTERM)
-            unset = {k: v for k, v in RAY_CONNECT_ENV.items() if k not in os.environ}
+        # Ray reads its settings when it loads: the connect timeouts go in before (only to
+        # join a cluster: a local instance's own processes must not inherit them).
+        joining = (address or os.environ.get("RAY_ADDRESS", "local")) != "local"
+        unset = {k: v for k, v in RAY_CONNECT_ENV.items() if joining and k not in os.environ}
+        with _environment(unset):
             try:
-                # Joining a cluster takes its settings; a local instance gets no dashboard.
-                extra = {} if address else {"include_dashboard": False}
-                with _environment(unset):
-                    ray.init(
-                        address=address,
-                        runtime_env=ray_runtime_env(upload_code),
-                        log_to_driver=False,
-                        **extra,
-                    )
-            except (ConnectionError, TimeoutError) as err:
+                import ray
+            except ImportError:
                 raise UserError(
-                    f"--address {address}: cannot reach a Ray cluster ({err})"
+                    f"--executor ray needs Ray: pip install 'ray[default]=={RAY_PIN}' "
+                    "(or the project's [ray] extra)"
                 ) from None
-            finally:
-                if sigterm is not None:
-                    with contextlib.suppress(ValueError):  # not the main thread
-                        signal.signal(signal.SIGTERM, sigterm)
+            if not ray.is_initialized():
+                _connect(ray, address, upload_code)
         remote = ray.remote(num_cpus=1)(work)
         pending = [remote.remote(spec) for spec in specs]
         try:
