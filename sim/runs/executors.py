@@ -49,7 +49,10 @@ WORKER_ENV = {
 }
 RAY_PIN = "2.60.0"
 STOP_SIGNALS = frozenset({signal.SIGINT, signal.SIGTERM})
-STOP_GRACE_S = 3.0  # a worker told to stop gets this long before SIGKILL
+# A stopped worker dies at once (SIGTERM is fatal to it); one still alive after this long
+# is blocked in start-up or caught SIGTERM, and gets SIGKILL.
+STOP_GRACE_S = 2.0
+EXIT_WAIT_S = 10.0  # for a worker that got its stop sign to free its GL context and exit
 RERUNS = 1  # times a run whose worker died is given to a fresh worker before it counts as failed
 
 RunFunction = Callable[[RunSpec, KeptRenderContext | None], dict[str, Any]]
@@ -167,13 +170,13 @@ def _died(proc: BaseProcess) -> str:
 
 
 def _stop_workers(slots: list[_Slot], grace: float, finished: bool) -> None:
-    """End every worker within a few `grace` periods: SIGTERM, then SIGKILL for the stubborn.
+    """End every worker: SIGTERM, then after `grace` SIGKILL for the stubborn.
 
-    `finished`: every worker got its stop sign and is first given `grace` to exit by
+    `finished`: every worker got its stop sign and is first given EXIT_WAIT_S to exit by
     itself; otherwise (a stop or an error) they are terminated at once.
     """
     if finished:
-        _join(slots, grace)
+        _join(slots, EXIT_WAIT_S)
     for stop in (BaseProcess.terminate, BaseProcess.kill):
         for slot in slots:
             if slot.proc.is_alive():
