@@ -20,11 +20,13 @@ import multiprocessing
 import os
 import signal
 import socket
+import threading
 import time
 import traceback
 from collections import Counter, deque
 from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass
+from multiprocessing import resource_tracker
 from multiprocessing.connection import Connection
 from multiprocessing.connection import wait as wait_for_any
 from multiprocessing.context import SpawnContext
@@ -76,9 +78,9 @@ def work(spec: RunSpec, kept: KeptRenderContext | None = None) -> dict[str, Any]
 def _worker(conn: Connection, run: RunFunction) -> None:
     """A local worker process: runs each spec the parent sends, until None or the parent is gone.
 
-    It starts with SIGINT and SIGTERM blocked (the parent blocks them while it spawns):
-    Ctrl-C is the parent's (a terminal sends it to the whole process group), so a pending
-    one is dropped here; a SIGTERM that came during start-up ends the worker on unblocking.
+    It starts with SIGINT blocked (the parent blocks it while it spawns): Ctrl-C is the
+    parent's (a terminal sends it to the whole process group), so a pending one is dropped
+    here. SIGTERM (the parent's stop) is fatal at any time.
     If the parent dies without stopping it (kill -9, out of memory), the worker notices
     between runs and exits instead of running the rest of the sweep for nobody.
     """
@@ -125,17 +127,36 @@ def _environment(env: dict[str, str]) -> Iterator[None]:
 
 @contextlib.contextmanager
 def _stop_signals_deferred() -> Iterator[None]:
-    """SIGINT and SIGTERM held back while workers spawn, delivered on leaving.
+    """SIGINT and SIGTERM held back while workers spawn, raised on leaving.
 
-    A stop that lands inside Process.start() would leave a started worker the sweep does
-    not know about; held back, it is raised once every worker is on the list to stop.
-    The children inherit the blocked mask; _worker unblocks it.
+    A stop raised inside Process.start() leaves a started worker the sweep does not know
+    about, or one that never gets its start-up data (an EOFError traceback of its own);
+    held back, it is raised once every worker is on the list to stop. The signal may be
+    delivered to any of this process's threads, so the handlers are swapped for one that
+    notes it (main thread only: elsewhere none can be set). SIGINT is also blocked in the
+    main thread's mask, which the children start with: a terminal's Ctrl-C reaches the
+    whole process group, and a worker still loading would die of it with a traceback
+    (_worker drops it and unblocks). SIGTERM stays deliverable, so a stop kills a
+    loading worker at once.
     """
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
+    resource_tracker.ensure_running()  # starting it later would unblock SIGINT again
+    held: list[int] = []
+
+    def hold(signum: int, frame: object) -> None:
+        held.append(signum)
+
+    previous = {}
+    if threading.current_thread() is threading.main_thread():
+        previous = {s: signal.signal(s, hold) for s in STOP_SIGNALS}
+    mask = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT})
     try:
         yield
     finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+        signal.pthread_sigmask(signal.SIG_SETMASK, mask)
+        for signum, handler in previous.items():
+            signal.signal(signum, signal.SIG_DFL if handler is None else handler)
+        for signum in dict.fromkeys(held):
+            signal.raise_signal(signum)  # now to the handlers held back
 
 
 @dataclass
