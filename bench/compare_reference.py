@@ -8,7 +8,8 @@ worker process that warms up on the first frames and then times one pass over al
 them. Reported: per-frame latency per stage (p50/p95) with the ratio ours/reference, on
 all frames and on the frames where both found the pedestrian (the same work); landmark
 error against the ground truth on the frames both found; CPU-seconds per frame and per
-hour at 15 fps (process CPU time of the timed pass: the energy proxy).
+hour at 15 fps (process CPU time of the timed pass: the energy proxy). The results go to
+bench/history.jsonl as one line (bench/history.py) unless --no-append.
 
     .venv/bin/python bench/compare_reference.py [--rounds 2] [--threads 1 2] [--no-append]
 """
@@ -23,13 +24,15 @@ import sys
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from common import append_this_run  # noqa: E402
 from frameset import FrameSet, build, load  # noqa: E402
+from goals import RATIO_GOAL  # noqa: E402
+from history import Recorder  # noqa: E402
 from paired import paired_median_difference  # noqa: E402
 from reference_env import ensure  # noqa: E402
 
@@ -37,7 +40,8 @@ ROOT = HERE.parent
 OURS, REF = "ours", "reference"
 SHOULDERS, HIPS = (11, 12), (23, 24)
 FPS = 15.0
-GOAL_RATIO = 0.5  # the issue: ours in at most half the reference's time per frame
+TITLE = "Ours vs the reference pipeline (MediaPipe 0.10.14 + rule cascade)"
+Row = dict[str, Any]  # one row of a results table in the history line
 
 
 @dataclass
@@ -128,8 +132,13 @@ def fmt(v: float, unit: str = "") -> str:
     return "-" if not np.isfinite(v) else f"{v:.2f}{unit}"
 
 
-def latency_table(col: Collected, threads: list[int], both: np.ndarray) -> list[str]:
-    """p50/p95 per stage and side for each thread count; ratios are side / reference."""
+def latency_table(
+    col: Collected, threads: list[int], both: np.ndarray, rows: list[Row]
+) -> list[str]:
+    """p50/p95 per stage and side for each thread count; ratios are side / reference.
+
+    Appends one row per (threads, frames, stage, side) to `rows`.
+    """
     sides = col.sides()
     ours = [x for x in sides if x != REF]
     head = " | ".join(f"{x} p50 | {x} p95" for x in sides)
@@ -152,6 +161,19 @@ def latency_table(col: Collected, threads: list[int], both: np.ndarray) -> list[
                     ]
                     p[side] = (pct(v, 50), pct(v, 95))
                 name = {"total": "whole frame", "pose": "pose", "post": "after pose"}[stage]
+                for x in sides:
+                    rows.append(
+                        {
+                            "threads": t,
+                            "frames": label,
+                            "stage": name,
+                            "side": x,
+                            "p50_ms": p[x][0],
+                            "p95_ms": p[x][1],
+                            "ratio_p50_x": None if x == REF else p[x][0] / p[REF][0],
+                            "ratio_p95_x": None if x == REF else p[x][1] / p[REF][1],
+                        }
+                    )
                 cells = " | ".join(f"{p[x][0]:.2f} ms | {p[x][1]:.2f} ms" for x in sides)
                 rat = " | ".join(
                     f"{p[x][0] / p[REF][0]:.2f} | {p[x][1] / p[REF][1]:.2f}" for x in ours
@@ -160,7 +182,7 @@ def latency_table(col: Collected, threads: list[int], both: np.ndarray) -> list[
     return lines
 
 
-def detail_table(col: Collected, threads: list[int]) -> list[str]:
+def detail_table(col: Collected, threads: list[int], rows: list[Row]) -> list[str]:
     """Our pose stage split: detector (frames that ran it) and landmark model."""
     lines = [
         "| threads | stage | frames per run | p50 | p95 |",
@@ -178,6 +200,16 @@ def detail_table(col: Collected, threads: list[int]) -> list[str]:
             lmk = [r["stages"]["landmarks"] for run in runs for r in run.rows]
             rounds = max(1, len(runs))
             for name, v in (("detect (acquiring frames)", det), ("landmark model", lmk)):
+                rows.append(
+                    {
+                        "threads": t,
+                        "side": side,
+                        "stage": name,
+                        "frames_per_run": len(v) // rounds,
+                        "p50_ms": pct(v, 50),
+                        "p95_ms": pct(v, 95),
+                    }
+                )
                 lines.append(
                     f"| {t} | {side}: {name} | {len(v) // rounds} | {pct(v, 50):.2f} ms "
                     f"| {pct(v, 95):.2f} ms |"
@@ -185,7 +217,7 @@ def detail_table(col: Collected, threads: list[int]) -> list[str]:
     return lines
 
 
-def agreement_table(col: Collected, threads: list[int]) -> tuple[list[str], float]:
+def agreement_table(col: Collected, threads: list[int], rows: list[Row]) -> tuple[list[str], float]:
     """Median whole-frame latency of every run, and the worst spread between runs."""
     lines = [
         "| threads | side | per-run p50 (ms) | spread |",
@@ -197,13 +229,14 @@ def agreement_table(col: Collected, threads: list[int]) -> tuple[list[str], floa
             meds = [pct([r["ms"] for r in run.rows], 50) for run in col.of(side, t)]
             spread = (max(meds) - min(meds)) / float(np.median(meds)) if len(meds) > 1 else 0.0
             worst = max(worst, spread)
+            rows.append({"threads": t, "side": side, "p50_ms": meds, "spread_pct": 100 * spread})
             lines.append(
                 f"| {t} | {side} | {', '.join(f'{m:.2f}' for m in meds)} | {100 * spread:.0f} % |"
             )
     return lines, worst
 
 
-def cpu_table(col: Collected, threads: list[int]) -> list[str]:
+def cpu_table(col: Collected, threads: list[int], rows: list[Row]) -> list[str]:
     lines = [
         "| threads | side | CPU-s per frame | wall s per frame | CPU-s per hour at 15 fps "
         "| cores busy at 15 fps | OS threads | peak RSS |",
@@ -216,6 +249,18 @@ def cpu_table(col: Collected, threads: list[int]) -> list[str]:
             wall = float(np.median([r.summary["wall_s"] / r.summary["frames"] for r in runs]))
             rss = max(r.summary["maxrss_mb"] for r in runs)
             threads_seen = max(r.summary["os_threads"] for r in runs)
+            rows.append(
+                {
+                    "threads": t,
+                    "side": side,
+                    "cpu_ms_per_frame": 1e3 * cpu,
+                    "wall_ms_per_frame": 1e3 * wall,
+                    "cpu_s_per_hour_at_15fps": cpu * FPS * 3600,
+                    "cores_busy_at_15fps": cpu * FPS,
+                    "os_threads": threads_seen,
+                    "peak_rss_mb": rss,
+                }
+            )
             lines.append(
                 f"| {t} | {side} | {1e3 * cpu:.1f} ms | {1e3 * wall:.1f} ms "
                 f"| {cpu * FPS * 3600:.0f} s | {cpu * FPS:.2f} | {threads_seen} | {rss:.0f} MB |"
@@ -223,12 +268,15 @@ def cpu_table(col: Collected, threads: list[int]) -> list[str]:
     return lines
 
 
-def error_table(fs: FrameSet, col: Collected, t: int) -> tuple[list[str], list[str]]:
+def error_table(
+    fs: FrameSet, col: Collected, t: int, rows: list[Row]
+) -> tuple[list[str], list[str]]:
     """Landmark error by frame group on the frames every side found; found shares beside.
 
     Where both sides found the same frames, the difference ours - reference comes with a
     95 % block-bootstrap interval (bench/paired.py) and a verdict: better or worse only
-    when the interval excludes zero. Returns the table and the groups where ours is worse.
+    when the interval excludes zero. Returns the table and the groups where ours is worse;
+    appends one row per (group, landmarks) to `rows` (verdict null where not judged).
     """
     sides = col.sides()
     runs = {x: col.of(x, t)[0] for x in sides}
@@ -270,14 +318,33 @@ def error_table(fs: FrameSet, col: Collected, t: int) -> tuple[list[str], list[s
             )
             cells = " | ".join(fmt(pooled_median(errs[x][key]), " px") for x in sides)
             paired, verdict = "-", "-"
+            row: Row = {
+                "group": name,
+                "frames": int(g.sum()),
+                "common_frames": len(common),
+                "found_pct": {x: 100 * float(found[x][g].mean()) for x in sides},
+                "landmarks": key,
+                "median_error_px": {x: pooled_median(errs[x][key]) for x in sides},
+                "difference_px": None,
+                "low_px": None,
+                "high_px": None,
+                "verdict": None,
+            }
             if len(common) and OURS in errs and REF in errs:
                 diff = paired_median_difference(
                     errs[OURS][key], errs[REF][key], fs.sequence[common]
                 )
                 paired = f"{diff.difference:+.2f} [{diff.low:+.2f}, {diff.high:+.2f}] px"
                 verdict = diff.verdict
+                row |= {
+                    "difference_px": diff.difference,
+                    "low_px": diff.low,
+                    "high_px": diff.high,
+                    "verdict": verdict,
+                }
                 if verdict == "worse":
                     worse.append(f"{name} {key}")
+            rows.append(row)
             lines.append(f"{head}| {key} | {cells} | {paired} | {verdict} |")
     return lines, worse
 
@@ -288,8 +355,9 @@ def main() -> None:
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--warmup", type=int, default=30)
     ap.add_argument("--no-pin", action="store_true", help="do not confine workers to N cores")
-    ap.add_argument("--no-append", action="store_true")
+    ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
+    recorder = Recorder("compare_reference", TITLE)
     npy, npz = build()
     fs = load(npy, npz)
     ref_python = ensure()
@@ -312,7 +380,27 @@ def main() -> None:
     n = len(fs)
     t0 = args.threads[0]
     both = np.logical_and.reduce([found_mask(col.of(x, t0)[0], n) for x in sides])
-    agree, worst = agreement_table(col, args.threads)
+    results: dict[str, Any] = {
+        "frames": n,
+        "width_px": int(fs.images.shape[2]),
+        "height_px": int(fs.images.shape[1]),
+        "sequences": fs.sequences,
+        "sides": list(sides),
+        "threads": args.threads,
+        "rounds": args.rounds,
+        "warmup_frames": args.warmup,
+        "pinned": not args.no_pin,
+        "load_min": min(loads),
+        "load_max": max(loads),
+        "latency": [],
+        "pose_split": [],
+        "per_run": [],
+        "cpu": [],
+        "landmark_error_threads": t0,
+        "landmark_error": [],
+    }
+    agree, worst = agreement_table(col, args.threads, results["per_run"])
+    results["worst_spread_pct"] = 100 * worst
     # The goal: whole-frame p50 at most half the reference's on the same work.
     verdict = []
     for t in args.threads:
@@ -321,9 +409,9 @@ def main() -> None:
             o = pct([r["ms"] for run in col.of(side, t) for r in run.rows if both[r["i"]]], 50)
             verdict.append(
                 f"{t} thread{'s' if t > 1 else ''}, {side}/ref = {o / f:.2f} "
-                f"({'meets' if o / f <= GOAL_RATIO else 'misses'} the <= {GOAL_RATIO} goal)"
+                f"({'meets' if o / f <= RATIO_GOAL else 'misses'} the <= {RATIO_GOAL} goal)"
             )
-    errors, worse = error_table(fs, col, t0)
+    errors, worse = error_table(fs, col, t0, results["landmark_error"])
     seqs = ", ".join(fs.sequences)
     lines = [
         f"{n} frames 768x432 in {len(fs.sequences)} sequences ({seqs}); "
@@ -336,11 +424,11 @@ def main() -> None:
         "Latency per frame (ratio < 1: faster than the reference; 'both found' = frames "
         "where every side returned a pose, i.e. the same work):",
         "",
-        *latency_table(col, args.threads, both),
+        *latency_table(col, args.threads, both, results["latency"]),
         "",
         "Our pose stage split:",
         "",
-        *detail_table(col, args.threads),
+        *detail_table(col, args.threads, results["pose_split"]),
         "",
         f"Run-to-run agreement of the whole-frame p50 (worst spread {100 * worst:.0f} %):",
         "",
@@ -348,7 +436,7 @@ def main() -> None:
         "",
         "Energy proxy (process CPU time of the timed pass; median over runs):",
         "",
-        *cpu_table(col, args.threads),
+        *cpu_table(col, args.threads, results["cpu"]),
         "",
         f"Landmark error vs ground truth, {t0} thread(s), frames all sides found (median over "
         "landmark instances; 'all visible' = the 33 mapped landmarks in the image and, "
@@ -362,8 +450,7 @@ def main() -> None:
     ]
     table = "\n".join(lines)
     print(table)
-    if not args.no_append:
-        append_this_run("Ours vs the reference pipeline (MediaPipe 0.10.14 + rule cascade)", table)
+    recorder.finish(results, table, write=not args.no_append)
 
 
 if __name__ == "__main__":

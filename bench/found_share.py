@@ -8,7 +8,8 @@ to acquire, then landmark tracking; no ground-truth crop), one tracker per clip.
 counts as found when the tracker returns a pose whose landmark box centre lies inside
 the mannequin's true box; a pose elsewhere counts as a false find. Only frames with the
 whole body inside the image are counted. Buckets are the true apparent height (box
-height) over the frame height. Prints the tables and appends them to BENCHMARKS.md.
+height) over the frame height. Prints the tables and appends them to bench/history.jsonl
+(bench/history.py) unless --no-append.
 
     .venv/bin/python bench/found_share.py [--frames 12] [--distances 2.4 3 4 ...]
         [--width 768 --height 432] [--montage recordings/found_share_cases.png] [--no-append]
@@ -20,7 +21,7 @@ import argparse
 import os
 import sys
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 import cv2
@@ -28,12 +29,13 @@ import numpy as np
 
 from monopic.cases import Case
 from monopic.pose.tracker import PoseTracker, TrackerConfig
-from sim.scenario.cases import place_case
+from sim.runs.loop import Listener, LoopFrame, StepTimes, run_loop
+from sim.scenario.cases import CasePlacement
 from sim.scenario.spec import CameraSpec, RobotSpec, Scenario
 from sim.world.world import World
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import append_this_run  # noqa: E402
+from history import Recorder  # noqa: E402
 
 BUCKETS = (
     (0.0, 1 / 8),
@@ -72,6 +74,63 @@ class Tally:
     def share(self) -> str:
         return f"{100 * self.found / self.frames:.1f} %" if self.frames else "-"
 
+    def record(self) -> dict[str, int | float | None]:
+        """The tally as a history row (share null without frames)."""
+        share = 100 * self.found / self.frames if self.frames else None
+        return {"frames": self.frames, "found": self.found, "false": self.false, "found_pct": share}
+
+
+def big_of(tallies: list[Tally]) -> Tally:
+    """The buckets where the body spans at least 1/4 of the frame, summed (as the table)."""
+    big = Tally()
+    for t in tallies[3:]:
+        big.frames += t.frames
+        big.found += t.found
+        big.false += t.false
+    return big
+
+
+def meets_bar(tallies: list[Tally]) -> bool:
+    big = big_of(tallies)
+    return bool(big.frames and big.found >= BAR * big.frames)
+
+
+@dataclass
+class FoundCounter(Listener):
+    """Runs the tracker on each frame of one clip and counts finds in the true box."""
+
+    tracker: PoseTracker
+    width: int
+    height: int
+    by_bucket: list[Tally]
+    by_case: list[Tally]
+    skipped: int = 0
+    thumb_at: int = -1  # frame to keep a montage thumbnail of
+    thumb_label: str = ""
+    thumbs: list[np.ndarray] = field(default_factory=list)
+
+    def frame(self, frame: LoopFrame) -> None:
+        assert frame.step.frame is not None
+        image, truth = frame.step.frame.image, frame.truth
+        result = self.tracker.process(image)
+        u0, v0, u1, v1 = truth.box
+        if not (u0 >= 0 and v0 >= 0 and u1 <= self.width and v1 <= self.height):
+            self.skipped += 1
+            return
+        found = false = False
+        if result.pose is not None:
+            bx0, by0, bx1, by1 = result.pose.box
+            cx, cy = (bx0 + bx1) / 2, (by0 + by1) / 2
+            found = u0 <= cx <= u1 and v0 <= cy <= v1
+            false = not found
+        b = bucket_of(truth.apparent_height / self.height)
+        for tally in (self.by_bucket[b], self.by_case[b]):
+            tally.frames += 1
+            tally.found += found
+            tally.false += false
+        if frame.index == self.thumb_at:
+            self.thumbs.append(annotate(image, self.thumb_label, truth.box, result))
+
 
 def bucket_of(ratio: float) -> int:
     return next(k for k, (lo, hi) in enumerate(BUCKETS) if lo <= ratio < hi)
@@ -79,7 +138,7 @@ def bucket_of(ratio: float) -> int:
 
 def clip(config: Config, distance: float, frames: int, camera: CameraSpec) -> Scenario:
     duration = frames / 15.0
-    sc = place_case(
+    sc = CasePlacement(
         config.case,
         distance=distance,
         robot_speed=0.0,
@@ -87,9 +146,8 @@ def clip(config: Config, distance: float, frames: int, camera: CameraSpec) -> Sc
         facing_deg=config.facing_deg,
         duration=duration,
         meet_time=duration / 2,
-        robot=RobotSpec(camera=camera),
         seed=int(distance * 10),
-    )
+    ).scenario(robot=RobotSpec(camera=camera))
     return replace(sc, name=f"{config.name} @ {distance} m")
 
 
@@ -101,50 +159,32 @@ def main() -> None:
     ap.add_argument("--height", type=int, default=432)
     ap.add_argument("--montage", type=Path, default=None, help="save a mid frame of each case")
     ap.add_argument("--montage-distance", type=float, default=6.0)
-    ap.add_argument("--no-append", action="store_true", help="do not write BENCHMARKS.md")
+    ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
+    recorder = Recorder("found_share", "Pose found share on rendered frames (issue 4)")
     camera = CameraSpec(width=args.width, height=args.height)
 
     tracker = PoseTracker(TrackerConfig())
     by_bucket = [Tally() for _ in BUCKETS]
     by_case = {c.name: [Tally() for _ in BUCKETS] for c in CONFIGS}
-    step_ms: list[float] = []
-    skipped = 0
+    times = StepTimes()
     thumbs: list[np.ndarray] = []
+    montage_distance = min(args.distances, key=lambda d: abs(d - args.montage_distance))
     t_start = time.perf_counter()
+    skipped = 0
     for config in CONFIGS:
         for distance in args.distances:
             tracker.reset()
+            counter = FoundCounter(
+                tracker, args.width, args.height, by_bucket, by_case[config.name]
+            )
+            if args.montage and distance == montage_distance:
+                counter.thumb_at, counter.thumb_label = args.frames // 2, config.name
             with World(clip(config, distance, args.frames, camera)) as world:
-                for k in range(args.frames):
-                    t0 = time.perf_counter()
-                    step = world.reset() if k == 0 else world.step()
-                    step_ms.append((time.perf_counter() - t0) * 1e3)
-                    assert step.frame is not None
-                    image, truth = step.frame.image, step.truth
-                    result = tracker.process(image)
-                    u0, v0, u1, v1 = truth.box
-                    if not (u0 >= 0 and v0 >= 0 and u1 <= args.width and v1 <= args.height):
-                        skipped += 1
-                        continue
-                    found = false = False
-                    if result.pose is not None:
-                        bx0, by0, bx1, by1 = result.pose.box
-                        cx, cy = (bx0 + bx1) / 2, (by0 + by1) / 2
-                        found = u0 <= cx <= u1 and v0 <= cy <= v1
-                        false = not found
-                    b = bucket_of(truth.apparent_height / args.height)
-                    for tally in (by_bucket[b], by_case[config.name][b]):
-                        tally.frames += 1
-                        tally.found += found
-                        tally.false += false
-                    if (
-                        args.montage
-                        and k == args.frames // 2
-                        and distance
-                        == min(args.distances, key=lambda d: abs(d - args.montage_distance))
-                    ):
-                        thumbs.append(annotate(image, config.name, truth.box, result))
+                run_loop(world, (), [times, counter], frames=args.frames, stop_at_contact=False)
+            skipped += counter.skipped
+            thumbs += counter.thumbs
+    step_ms = times.ms
     elapsed = time.perf_counter() - t_start
 
     total = sum(t.frames for t in by_bucket)
@@ -184,13 +224,39 @@ def main() -> None:
         lines.append(f"| {config.name} | {cells} | {big.share()} ({big.frames}) | {ok} |")
     body = "\n".join(lines)
     print(body)
+    results = {
+        "configurations": len(CONFIGS),
+        "distances_m": args.distances,
+        "frames_per_clip": args.frames,
+        "width_px": args.width,
+        "height_px": args.height,
+        "frames_counted": total,
+        "frames_cut_by_border": skipped,
+        "world_step_median_ms": float(np.median(step_ms)),
+        "bar_pct": 100 * BAR,
+        "by_height": [
+            {"apparent_height": name, **t.record()}
+            for name, t in zip(BUCKET_NAMES, by_bucket, strict=True)
+        ],
+        "by_case": [
+            {
+                "case": c.name,
+                "by_height": [
+                    {"apparent_height": name, **t.record()}
+                    for name, t in zip(BUCKET_NAMES, by_case[c.name], strict=True)
+                ],
+                "at_least_quarter": big_of(by_case[c.name]).record(),
+                "meets_bar": meets_bar(by_case[c.name]),
+            }
+            for c in CONFIGS
+        ],
+    }
 
     if args.montage and thumbs:
         args.montage.parent.mkdir(parents=True, exist_ok=True)
         cv2.imwrite(str(args.montage), cv2.cvtColor(montage(thumbs), cv2.COLOR_RGB2BGR))
         print(f"montage of one frame per case -> {args.montage}")
-    if not args.no_append:
-        append_this_run("Pose found share on rendered frames (issue 4)", body)
+    recorder.finish(results, body, write=not args.no_append)
 
 
 def annotate(image: np.ndarray, label: str, box: tuple, result: object) -> np.ndarray:

@@ -85,19 +85,19 @@ def _rendered(case: int, distance: float, frames: int):
     from dataclasses import replace
 
     from monopic.cases import Case
-    from sim.scenario.cases import place_case
+    from sim.scenario.cases import CasePlacement
     from sim.world.ground_truth import in_image
     from sim.world.world import World
 
     duration = frames / 15.0
-    sc = place_case(
+    sc = CasePlacement(
         Case(case),
         distance=distance,
         robot_speed=0.0,
         duration=duration,
         meet_time=duration / 2,
         seed=int(distance * 10) + case,
-    )
+    ).scenario()
     sc = replace(sc, name=f"case{case}@{distance:g}m")
     images, lms, vis, ts = [], [], [], []
     with World(sc) as world:

@@ -22,11 +22,10 @@ from __future__ import annotations
 
 import argparse
 import itertools
-import json
 import math
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Protocol
 
@@ -34,6 +33,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from monopic.camera import CameraModel
+from monopic.errors import UserError
 from monopic.features.ground import GroundMotion, Odometry
 from monopic.features.ground_track import GroundTrackConfig
 from monopic.features.motion import VelocityEstimator
@@ -45,11 +45,14 @@ from monopic.predict.registry import make_predictor
 from monopic.variants.warning import CollisionWarning
 from monopic.variants.zone import RobotGeometry
 from sim.analysis.metrics import FrameCounts, judge_run, summarise
+from sim.runs.result import MAIN, DecisionColumns, RunResult
+from sim.runs.results_file import read_results
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import append_this_run  # noqa: E402
+from history import Recorder  # noqa: E402
 
 METHOD = "constant-velocity/ground"
+TITLE = "Ground-motion estimators replayed on a sweep's foot points"
 MAX_GAP = 0.5  # s, FeatureExtractor.max_gap: a longer gap restarts the track
 CAR_MOUNT_FORWARD = 0.8  # m, sim.scenario.families' car camera (not in the result line)
 
@@ -88,41 +91,39 @@ class FiniteDifferences:
         self.velocity.reset()
 
 
-def camera(row: dict[str, Any]) -> CameraModel:
-    c = row["scenario"]["camera"]
-    forward = CAR_MOUNT_FORWARD if row["scale"] == "car" else 0.0
+def camera(row: RunResult) -> CameraModel:
+    c = row.scenario.camera
+    forward = CAR_MOUNT_FORWARD if row.scale == "car" else 0.0
     return CameraModel.from_fov(
-        c["width"], c["height"], c["vertical_fov_deg"], c["mount_height"], c["pitch_deg"], forward
+        c.width, c.height, c.vertical_fov_deg, c.mount_height, c.pitch_deg, forward
     )
 
 
-def replay(row: dict[str, Any], estimator: Estimator) -> tuple[list, list]:
+def replay(row: RunResult, estimator: Estimator) -> tuple[list, list]:
     """Per frame: the warning (None without a pose) and the predicted ground point."""
-    s = row["scenario"]
-    cam, horizon = camera(row), s["horizon"]
-    robot = RobotGeometry(
-        width=s["robot_width"], length=s["robot_length"], front=s["robot_length"] / 2
-    )
+    s = row.scenario
+    cam, horizon = camera(row), s.horizon
+    robot = RobotGeometry(width=s.robot_width, length=s.robot_length, front=s.robot_length / 2)
     warning = CollisionWarning(robot=robot)
     predictor = make_predictor("constant-velocity", Mode.GROUND)
-    main, truth = row["pipelines"]["main"], row["truth"]
-    size = (s["camera"]["width"], s["camera"]["height"])
+    main, truth = row.pipelines[MAIN], row.truth
+    size = (s.camera.width, s.camera.height)
     warn: list[int | None] = []
     ground: list[tuple[float, float] | None] = []
     last = None
-    for k, t in enumerate(truth["t"]):
-        ego = EgoState(cam, truth["robot_speed"][k], 0.0)
+    for k, t in enumerate(truth.t):
+        ego = EgoState(cam, truth.robot_speed[k], 0.0)
         estimator.observe_ego(t, ego)
         if last is not None and t - last > MAX_GAP:
             estimator.reset_track()
             last = None
-        foot = main["foot"][k] if main["found"][k] else None
+        foot = main.foot[k] if main.found[k] else None
         if foot is None:
             warn.append(None)
             ground.append(None)
             continue
         last = t
-        got = estimator.update(t, ego, (foot[0], foot[1]), main["height"][k] or 0.0)
+        got = estimator.update(t, ego, (foot[0], foot[1]), main.height[k] or 0.0)
         gf = None if got is None else GroundFeatures(got[0], got[1], cam)
         feats = Features(t, (foot[0], foot[1]), (foot[0], foot[1]), 0.0, 0.0, 0.0, 0.0, gf)
         if gf is None:
@@ -142,6 +143,29 @@ class Judged:
     agreement: float
     outcomes: list
     errors: np.ndarray
+
+    def record(self) -> dict[str, Any]:
+        """The row's figures as history data (errors in metres)."""
+        sm = summarise(METHOD, self.outcomes)
+        f = sum((o.frames for o in self.outcomes), FrameCounts())
+        near = [o for o in self.outcomes if o.near_miss]
+        e = self.errors
+        return {
+            "estimator": self.name,
+            "agreement_pct": 100 * self.agreement,
+            "collision_runs": sm.collision_runs,
+            "warned_1s": sm.warned_1s,
+            "warned": sm.warned,
+            "near_misses": len(near),
+            "near_misses_warned": sum(o.warned for o in near),
+            "false_alarm_frames": f.fp,
+            "frame_precision": f.tp / max(f.tp + f.fp, 1),
+            "frame_recall": f.tp / max(f.tp + f.fn, 1),
+            "error_p50_m": float(np.percentile(e, 50)),
+            "error_p90_m": float(np.percentile(e, 90)),
+            "error_p99_m": float(np.percentile(e, 99)),
+            "error_over_10m_pct": float(100 * np.mean(e > 10)),
+        }
 
     def row(self) -> str:
         sm = summarise(METHOD, self.outcomes)
@@ -163,21 +187,20 @@ class Judged:
         return "| " + " | ".join(cells) + " |"
 
 
-def judge(rows: list[dict[str, Any]], name: str, make: Callable[[], Estimator]) -> Judged:
+def judge(rows: list[RunResult], name: str, make: Callable[[], Estimator]) -> Judged:
     outcomes, errors = [], []
     agree = total = 0
     for row in rows:
         warn, ground = replay(row, make())
-        logged = (row["pipelines"]["main"]["decisions"].get(METHOD) or {}).get("warn")
-        logged = logged or [None] * len(warn)
+        main = row.pipelines[MAIN]
+        logged_cols = main.decisions.get(METHOD)
+        logged = logged_cols.warn if logged_cols else [None] * len(warn)
         agree += sum((a or 0) == (b or 0) for a, b in zip(warn, logged, strict=True))
         total += len(warn)
-        main = row["pipelines"]["main"]
-        decisions = {METHOD: {**(main["decisions"].get(METHOD) or {}), "warn": warn}}
-        outcomes.append(
-            judge_run({**row, "pipelines": {"main": {**main, "decisions": decisions}}}, METHOD)
-        )
-        for end, fut in zip(ground, row["truth"]["future"], strict=True):
+        replayed = replace(logged_cols or DecisionColumns(), warn=warn)
+        pipelines = {MAIN: replace(main, decisions={METHOD: replayed})}
+        outcomes.append(judge_run(replace(row, pipelines=pipelines), METHOD))
+        for end, fut in zip(ground, row.truth.future, strict=True):
             if end is not None and fut is not None:
                 errors.append(math.hypot(end[0] - fut[0], end[1] - fut[1]))
     return Judged(name, agree / max(total, 1), outcomes, np.array(errors))
@@ -201,15 +224,13 @@ def plot(judged: list[Judged], path: Path, title: str) -> None:
         fig.savefig(tmp, dpi=110)
 
 
-def load(path: Path) -> list[dict[str, Any]]:
+def load(path: Path) -> list[RunResult]:
     if not path.is_file():
         sys.exit(f"{path}: no such results file (write one with `monopic sweep`)")
-    rows = []
-    for n, line in enumerate(path.read_text().splitlines(), 1):
-        try:
-            rows.append(json.loads(line))
-        except json.JSONDecodeError as e:
-            sys.exit(f"{path}:{n}: not a JSON result line ({e.msg})")
+    try:
+        rows = list(read_results(path))
+    except UserError as err:
+        sys.exit(str(err))
     if not rows:
         sys.exit(f"{path}: no result lines")
     return rows
@@ -222,8 +243,9 @@ def main() -> None:
     ap.add_argument("--initial-speed", type=float, nargs="+", default=[])
     ap.add_argument("--pixel-noise-per-height", type=float, nargs="+", default=[])
     ap.add_argument("--plot", type=Path, help="PNG of the error distributions")
-    ap.add_argument("--no-append", action="store_true")
+    ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
+    recorder = Recorder("ground_replay", TITLE)
     rows = load(args.results)
     shipped = GroundTrackConfig()
     candidates: list[tuple[str, Callable[[], Estimator]]] = [
@@ -262,8 +284,13 @@ def main() -> None:
         lines += ["", f"![error distributions]({args.plot})"]
     table = "\n".join(lines)
     print(table)
-    if not args.no_append:
-        append_this_run("Ground-motion estimators replayed on a sweep's foot points", table)
+    results = {
+        "results_file": str(args.results),
+        "runs": len(rows),
+        "method": METHOD,
+        "estimators": [j.record() for j in judged],
+    }
+    recorder.finish(results, table, write=not args.no_append)
 
 
 if __name__ == "__main__":

@@ -2,9 +2,9 @@
 
 Runs alternate between thread counts (A B A B ...) so machine noise hits both alike; the
 first pass over the clip of each is warm-up and not timed. Prints p50/p95 per stage and
-appends the table to BENCHMARKS.md.
+appends them to bench/history.jsonl (bench/history.py) unless --no-append.
 
-    .venv/bin/python bench/pipeline_latency.py [VIDEO] [--rounds 3]
+    .venv/bin/python bench/pipeline_latency.py [VIDEO] [--rounds 3] [--no-append]
 """
 
 from __future__ import annotations
@@ -13,6 +13,7 @@ import argparse
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -21,7 +22,7 @@ from monopic.pose.tracker import TrackerConfig
 from monopic.video import VideoSource
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import append_section  # noqa: E402
+from history import Recorder  # noqa: E402
 
 STAGES = ("detect", "landmarks", "pose", "features", "predict", "warning", "total")
 # The tracker detects only when it (re)acquires; this row times one whole-frame detector
@@ -48,7 +49,9 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("video", nargs="?", type=Path, default=DEFAULT_VIDEO)
     ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
+    recorder = Recorder("pipeline_latency", "Pipeline latency per stage")
     frames = list(VideoSource(str(args.video)))
     h, w = frames[0].image.shape[:2]
     for threads in (1, 2):  # warm-up
@@ -66,23 +69,44 @@ def main() -> None:
         "| stage | 1 thread p50 | p95 | 2 threads p50 | p95 | ratio p50 (1/2) |",
         "| --- | --- | --- | --- | --- | --- |",
     ]
+    stages: list[dict[str, Any]] = []
     for s in rows:
         a, b = np.array(results[1][s]), np.array(results[2][s])
         if a.size == 0 or b.size == 0:
             continue
         p = [np.percentile(a, 50), np.percentile(a, 95), np.percentile(b, 50), np.percentile(b, 95)]
         ratio = p[0] / p[2] if p[2] > 0 else float("nan")
+        stages.append(
+            {
+                "stage": s,
+                "samples_1_thread": int(a.size),
+                "p50_1_thread_ms": p[0],
+                "p95_1_thread_ms": p[1],
+                "samples_2_threads": int(b.size),
+                "p50_2_threads_ms": p[2],
+                "p95_2_threads_ms": p[3],
+                "ratio_p50_1_to_2_x": ratio,
+            }
+        )
         lines.append(
             f"| {s} | {p[0]:.2f} ms | {p[1]:.2f} ms | {p[2]:.2f} ms | {p[3]:.2f} ms | {ratio:.2f} |"
         )
+    lines += [
+        "",
+        "`detect` counts only frames where the tracker (re)acquires; "
+        "`pose` = detect + crop + landmarks.",
+    ]
     table = "\n".join(lines)
     print(table)
-    append_section(
-        "Pipeline latency per stage",
-        f".venv/bin/python bench/pipeline_latency.py {args.video.name} --rounds {args.rounds}",
-        table + "\n\n`detect` counts only frames where the tracker (re)acquires; "
-        "`pose` = detect + crop + landmarks.",
-    )
+    summary = {
+        "video": args.video.name,
+        "frames": len(frames),
+        "width_px": w,
+        "height_px": h,
+        "rounds": args.rounds,
+        "stages": stages,
+    }
+    recorder.finish(summary, table, write=not args.no_append)
 
 
 if __name__ == "__main__":

@@ -6,7 +6,8 @@ velocity, foot point, ground motion; each predictor; warning; path projection) i
 replayed over those poses many times, a fresh FeatureExtractor per sequence, exactly as
 Pipeline.process runs it. One onnxruntime-free, single-threaded Python loop: the
 thread count does not matter here. Operation counts come from monopic/tree/opcount.py:
-the worst case over inputs and the mean over the recorded frames.
+the worst case over inputs and the mean over the recorded frames. The results go to
+bench/history.jsonl (bench/history.py) unless --no-append.
 
     .venv/bin/python bench/post_pose.py [--repeats 30] [--no-append]
 """
@@ -16,7 +17,9 @@ from __future__ import annotations
 import argparse
 import sys
 import time
+from dataclasses import asdict
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -38,8 +41,8 @@ from monopic.variants.warning import CollisionWarning
 from sim.scenario.spec import CameraSpec
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
-from common import append_this_run  # noqa: E402
 from frameset import build, load  # noqa: E402
+from history import Recorder  # noqa: E402
 
 PAPER_TREE_MS = 8.0
 HORIZON = 1.0
@@ -106,8 +109,9 @@ def replay(fs, poses, predictors, ego, size) -> dict[str, float]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeats", type=int, default=30, help="timed passes per predictor set")
-    ap.add_argument("--no-append", action="store_true")
+    ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
+    recorder = Recorder("post_pose", "Stage after pose: time and operation count")
     npy, npz = build()
     fs = load(npy, npz)
     n = len(fs)
@@ -128,6 +132,7 @@ def main() -> None:
         "| pass spread | vs paper's 8 ms |",
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
+    sets: list[dict[str, Any]] = []
     for label, names, with_ego in SETS:
         predictors = [make_predictor(name, mode) for name, mode in names]
         ego = ego_still if with_ego else None
@@ -138,6 +143,18 @@ def main() -> None:
         totals = [sum(p.values()) * 1e6 / n for p in passes]
         total = float(np.median(totals))
         spread = (max(totals) - min(totals)) / total
+        sets.append(
+            {
+                "set": label,
+                "predictors": [f"{name}/{mode.value}" for name, mode in names],
+                "features_us": per["features"],
+                "predict_us": per["predict"],
+                "warning_path_us": per["warning + path"],
+                "total_us": total,
+                "pass_spread_pct": 100 * spread,
+                "faster_than_paper_x": PAPER_TREE_MS * 1e3 / total,
+            }
+        )
         lines.append(
             f"| {label} | {per['features']:.1f} µs | {per['predict']:.1f} µs "
             f"| {per['warning + path']:.1f} µs | {total:.1f} µs | {100 * spread:.0f} % "
@@ -173,8 +190,26 @@ def main() -> None:
     ]
     table = "\n".join(lines)
     print(table)
-    if not args.no_append:
-        append_this_run("Stage after pose: time and operation count", table)
+    results = {
+        "frames": n,
+        "frames_with_pose": found,
+        "repeats": args.repeats,
+        "paper_tree_ms": PAPER_TREE_MS,
+        "sets": sets,
+        "tree_ops": {
+            "paper_calculations": PAPER_CALCULATIONS_PER_PREDICTION,
+            "worst_prediction": worst.total.total,
+            "worst_prediction_by_kind": asdict(worst.total),
+            "worst_stage": stage_worst.total,
+            "worst_stage_by_kind": asdict(stage_worst),
+            "mean_prediction": mean,
+            "min_prediction": lo,
+            "max_prediction": hi,
+            "mean_stage": stage_mean,
+            "recorded_frames": len(feats),
+        },
+    }
+    recorder.finish(results, table, write=not args.no_append)
 
 
 if __name__ == "__main__":

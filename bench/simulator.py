@@ -7,7 +7,8 @@ rendering), frames per second of a whole scenario run (sim.runs.runner.run: rend
 pipeline with all five predictors + bookkeeping) pinned to one core with and without
 the ground-truth-crop ablation pipeline, and sweep throughput through sim.runs.executors'
 spawned workers (1 and 2), with the peak RSS of a worker (ru_maxrss of the
-reaped children).
+reaped children). The results go to bench/history.jsonl (bench/history.py) unless
+--no-append.
 
     .venv/bin/python bench/simulator.py [--frames 60] [--runs 6] [--no-append]
 """
@@ -27,11 +28,12 @@ from typing import Any
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from common import append_this_run  # noqa: E402
+from history import Recorder  # noqa: E402
 
 REALTIME_FPS = 15.0
 CASES = (1, 2, 3, 4, 5, 6, 8)  # walking cases; still (9) has no motion to predict
 RUN_CASES = (5, 3, 5, 3)  # the whole-run rows: two cases twice, so one noisy run moves no median
+TITLE = "Simulator: render time, scenario run on one core, sweep throughput"
 
 
 def scenario(case: int, frames: int, seed: int = 0, shadows: bool = True) -> Any:
@@ -42,9 +44,9 @@ def scenario(case: int, frames: int, seed: int = 0, shadows: bool = True) -> Any
     from dataclasses import replace
 
     from monopic.cases import Case
-    from sim.scenario.cases import place_case
+    from sim.scenario.cases import CasePlacement
 
-    sc = place_case(Case(case), duration=frames / REALTIME_FPS, seed=seed)
+    sc = CasePlacement(Case(case), duration=frames / REALTIME_FPS, seed=seed).scenario()
     return replace(sc, scene=replace(sc.scene, shadows=shadows))
 
 
@@ -52,19 +54,16 @@ def child_render(frames: int) -> dict[str, Any]:
     """World.step with and without rendering, one core; first frame (GL setup) excluded."""
     import numpy as np
 
+    from sim.runs.loop import StepTimes, run_loop
     from sim.world.world import World
 
     out: dict[str, Any] = {}
     for render in (False, True, False, True):  # alternated, the second pair kept
         sc = scenario(5, frames)
+        times = StepTimes()
         with World(sc, render=render) as world:
-            world.reset()
-            ms = []
-            for _ in range(frames - 1):
-                t0 = time.perf_counter()
-                world.step()
-                ms.append((time.perf_counter() - t0) * 1e3)
-        out["render" if render else "no_render"] = ms
+            run_loop(world, (), [times], frames=frames, stop_at_contact=False)
+        out["render" if render else "no_render"] = times.ms[1:]  # steps, not the reset
     res = {}
     for k, v in out.items():
         a = np.array(v[2:])
@@ -96,7 +95,7 @@ def child_run(frames: int, ablation: bool, shadows: bool = True) -> dict[str, An
             cpu0, t0 = time.process_time(), time.perf_counter()
             result = run(spec, render_context=context)
             wall, cpu = time.perf_counter() - t0, time.process_time() - cpu0
-            results.append({"frames": result["frames"], "wall_s": wall, "cpu_s": cpu})
+            results.append({"frames": result.frames, "wall_s": wall, "cpu_s": cpu})
     return {
         "runs": results,
         "maxrss_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
@@ -152,7 +151,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--frames", type=int, default=60, help="frames per scenario run (15 fps)")
     ap.add_argument("--runs", type=int, default=6, help="runs per sweep throughput test")
-    ap.add_argument("--no-append", action="store_true")
+    ap.add_argument("--no-append", action="store_true", help="do not write the history")
     ap.add_argument("--child", choices=("render", "run", "sweep"), help=argparse.SUPPRESS)
     ap.add_argument("--pin", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--ablation", type=int, default=0, help=argparse.SUPPRESS)
@@ -171,6 +170,7 @@ def main() -> None:
         print(json.dumps(out))
         return
 
+    recorder = Recorder("simulator", TITLE)
     load0 = os.getloadavg()[0]
     start = time.perf_counter()
     render = spawn_child("render", True, frames=args.frames)
@@ -185,7 +185,7 @@ def main() -> None:
     load1 = os.getloadavg()[0]
     r, nr = render["render"], render["no_render"]
     lines = [
-        f"Scenarios: sim.scenario.cases.place_case, 8 m, robot 2 m/s, {args.frames} frames "
+        f"Scenarios: sim.scenario.cases.CasePlacement, 8 m, robot 2 m/s, {args.frames} frames "
         f"at 15 fps, 768x432; child processes with sim.runs.executors.WORKER_ENV; load average "
         f"{load0:.1f} before, {load1:.1f} after, on {os.cpu_count()} cores; "
         f"{time.perf_counter() - start:.0f} s in all.",
@@ -201,12 +201,40 @@ def main() -> None:
         "| CPU-s per frame | vs real time at 15 fps | peak RSS |",
         "| --- | ---: | ---: | ---: | ---: | ---: |",
     ]
+    results: dict[str, Any] = {
+        "frames_per_run": args.frames,
+        "sweep_runs": args.runs,
+        "world_step": {
+            "render_p50_ms": r["p50"],
+            "render_p95_ms": r["p95"],
+            "no_render_p50_ms": nr["p50"],
+            "no_render_p95_ms": nr["p95"],
+            "render_alone_p50_ms": r["p50"] - nr["p50"],
+        },
+        "scenario_runs": [],
+        "sweeps": [],
+    }
     for (ab, sh), res in runs.items():
         fps = sorted(x["frames"] / x["wall_s"] for x in res["runs"])
         med = statistics.median(fps)
         cpu = sum(x["cpu_s"] for x in res["runs"]) / sum(x["frames"] for x in res["runs"])
         name = "render + pipeline (5 predictors)" + (" + ground-truth-crop ablation" if ab else "")
         name += "" if sh else ", overcast (no shadow pass)"
+        results["scenario_runs"].append(
+            {
+                "name": name,
+                "ablation": bool(ab),
+                "shadows": bool(sh),
+                "frames": res["runs"][0]["frames"],
+                "runs": len(fps),
+                "fps_median": med,
+                "fps_min": fps[0],
+                "fps_max": fps[-1],
+                "cpu_ms_per_frame": 1e3 * cpu,
+                "realtime_x": med / REALTIME_FPS,
+                "peak_rss_mb": res["maxrss_mb"],
+            }
+        )
         lines.append(
             f"| {name} | {res['runs'][0]['frames']} | {med:.1f} ({fps[0]:.1f}-{fps[-1]:.1f}) "
             f"| {1e3 * cpu:.1f} ms | {med / REALTIME_FPS:.2f}x "
@@ -221,6 +249,18 @@ def main() -> None:
     base = sweeps[1]["frames"] / sweeps[1]["wall_s"]
     for w, s in sweeps.items():
         fps = s["frames"] / s["wall_s"]
+        results["sweeps"].append(
+            {
+                "workers": w,
+                "runs": s["runs"],
+                "frames": s["frames"],
+                "wall_s": s["wall_s"],
+                "runs_per_minute": 60 * s["runs"] / s["wall_s"],
+                "fps": fps,
+                "speedup_x": fps / base,
+                "worker_peak_rss_mb": s["worker_maxrss_mb"],
+            }
+        )
         lines.append(
             f"| {w} worker{'s' if w > 1 else ''} | {s['runs']} | {s['wall_s']:.1f} s "
             f"| {60 * s['runs'] / s['wall_s']:.1f} | {fps:.1f} | {fps / base:.2f}x "
@@ -232,8 +272,7 @@ def main() -> None:
     )
     table = "\n".join(lines)
     print(table)
-    if not args.no_append:
-        append_this_run("Simulator: render time, scenario run on one core, sweep throughput", table)
+    recorder.finish(results, table, write=not args.no_append)
 
 
 if __name__ == "__main__":

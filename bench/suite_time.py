@@ -2,6 +2,7 @@
 
 Timed once (the issue asks for the suite's own run time, not a distribution); the
 pytest summary line is kept beside the time, since a failing or skipped test changes it.
+The results go to bench/history.jsonl (bench/history.py) unless --no-append.
 
     .venv/bin/python bench/suite_time.py [--no-append]
 """
@@ -17,7 +18,7 @@ from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
-from common import append_this_run  # noqa: E402
+from history import Recorder  # noqa: E402
 
 ROOT = HERE.parent
 SUITES = (
@@ -38,13 +39,16 @@ def run_suite(args: list[str]) -> tuple[float, str, int]:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--no-append", action="store_true")
+    ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
+    recorder = Recorder("suite_time", "Test suite run time")
     load0 = os.getloadavg()[0]
     lines = ["| suite | wall | pytest summary | exit |", "| --- | ---: | --- | ---: |"]
+    suites = []
     for name, pytest_args in SUITES:
         wall, summary, code = run_suite(pytest_args)
         lines.append(f"| {name} | {wall:.0f} s | {summary} | {code} |")
+        suites.append({"suite": name, "wall_s": wall, "summary": summary, "exit_code": code})
     lines.insert(
         0,
         f"`.venv/bin/python -m pytest` as listed, once each; load average {load0:.1f} before, "
@@ -52,8 +56,7 @@ def main() -> None:
     )
     table = "\n".join(lines)
     print(table)
-    if not args.no_append:
-        append_this_run("Test suite run time", table)
+    recorder.finish({"suites": suites}, table, write=not args.no_append)
 
 
 if __name__ == "__main__":

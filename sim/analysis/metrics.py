@@ -32,10 +32,9 @@ import numpy as np
 
 from monopic.cases import Case
 from sim.runs.code_version import UNKNOWN
+from sim.runs.result import ABLATION, MAIN, DecisionColumns, RunResult
 
 Z95 = 1.959963984540054
-MAIN = "main"
-ABLATION = "gtcrop"
 TIMELY_TTC = 1.7  # s, Euro NCAP's timely forward collision warning
 LEAD_GOAL = 1.0  # s, the issue's goal: warned at least this long before contact
 RANGE_BINS = (0.0, 5.0, 10.0, 15.0, 20.0, 30.0, 50.0, 1e9)  # m
@@ -70,12 +69,13 @@ def split_method(method: str) -> tuple[str, str]:
     return MAIN, method
 
 
-def methods(rows: Iterable[dict[str, Any]]) -> list[str]:
+def methods(rows: Iterable[RunResult]) -> list[str]:
     """Every (pipeline, predictor) pair present, main pipeline first, in a stable order."""
     found: dict[str, None] = {}
     for row in rows:
         for pipeline in (MAIN, ABLATION):
-            for key in row["pipelines"].get(pipeline, {}).get("decisions", {}):
+            columns = row.pipelines.get(pipeline)
+            for key in columns.decisions if columns else ():
                 found[method_name(pipeline, key)] = None
     return sorted(found, key=_method_order)
 
@@ -90,13 +90,13 @@ def _method_order(method: str) -> tuple[int, int, int, str]:
     return (pipeline != MAIN, _ORDER.get(mode, 9), _ORDER.get(name, 9), key)
 
 
-def dedupe(rows: Iterable[dict[str, Any]]) -> list[dict[str, Any]]:
+def dedupe(rows: Iterable[RunResult]) -> list[RunResult]:
     """One row per run id (the first), so a file appended twice counts each run once."""
     seen: set[str] = set()
     out = []
     for row in rows:
-        if row["id"] not in seen:
-            seen.add(row["id"])
+        if row.id not in seen:
+            seen.add(row.id)
             out.append(row)
     return out
 
@@ -165,43 +165,44 @@ class RunOutcome:
         return self.kind == "near-miss" and not self.collision_run
 
 
-def _decisions(row: dict[str, Any], method: str) -> dict[str, list[Any]] | None:
+def _decisions(row: RunResult, method: str) -> DecisionColumns | None:
     pipeline, key = split_method(method)
-    return row["pipelines"].get(pipeline, {}).get("decisions", {}).get(key)
+    columns = row.pipelines.get(pipeline)
+    return columns.decisions.get(key) if columns else None
 
 
-def run_case(row: dict[str, Any]) -> int:
+def run_case(row: RunResult) -> int:
     """The run's case: the one the scenario was built for, else the most common true case."""
-    case = row["scenario"].get("case")
+    case = row.scenario.case
     if case is not None:
         return int(case)
-    return Counter(row["truth"]["case"]).most_common(1)[0][0]
+    return Counter(row.truth.case).most_common(1)[0][0]
 
 
-def contact_time(row: dict[str, Any]) -> float | None:
+def contact_time(row: RunResult) -> float | None:
     """First contact by the truth: where frames on a collision course say it will happen."""
-    truth = row["truth"]
-    times = [t + c for t, c in zip(truth["t"], truth["ttc"], strict=True) if c is not None]
+    truth = row.truth
+    times = [t + c for t, c in zip(truth.t, truth.ttc, strict=True) if c is not None]
     return min(times) if times else None
 
 
-def frame_latency_ms(row: dict[str, Any], pipeline: str, k: int) -> float | None:
+def frame_latency_ms(row: RunResult, pipeline: str, k: int) -> float | None:
     """Measured latency of frame k for one predictor: shared stages + its share of the rest."""
-    ms = row.get("timing", {}).get("ms", {}).get(pipeline)
+    ms = row.timing.ms.get(pipeline)
     if not ms:
         return None
     pose, feats = ms["pose"][k], ms["features"][k]
     if pose is None:
         return None
-    decisions = row["pipelines"][pipeline]["decisions"]
-    n = sum(1 for cols in decisions.values() if cols["warn"][k] is not None)
+    decisions = row.pipelines[pipeline].decisions
+    n = sum(1 for cols in decisions.values() if cols.warn[k] is not None)
     shared = (ms["predict"][k] or 0.0) + (ms["warning"][k] or 0.0)
     return pose + (feats or 0.0) + (shared / n if n else 0.0)
 
 
-def available_times(row: dict[str, Any], pipeline: str) -> list[float | None]:
+def available_times(row: RunResult, pipeline: str) -> list[float | None]:
     """When each frame's outputs exist on a real-time single-core pipeline (None: skipped)."""
-    times = row["truth"]["t"]
+    times = row.truth.t
     out: list[float | None] = []
     busy_until = -math.inf
     for k, t in enumerate(times):
@@ -217,13 +218,13 @@ def available_times(row: dict[str, Any], pipeline: str) -> list[float | None]:
     return out
 
 
-def judge_run(row: dict[str, Any], method: str) -> RunOutcome:
-    truth = row["truth"]
+def judge_run(row: RunResult, method: str) -> RunOutcome:
+    truth = row.truth
     cols = _decisions(row, method)
-    n = len(truth["t"])
-    warn = [bool(v) for v in cols["warn"]] if cols else [False] * n
-    positive = [bool(v) for v in truth["collision"]]
-    on_course = [c is not None for c in truth["ttc"]]
+    n = len(truth.t)
+    warn = [bool(v) for v in cols.warn] if cols else [False] * n
+    positive = [bool(v) for v in truth.collision]
+    on_course = [c is not None for c in truth.ttc]
     counts = FrameCounts(
         tp=sum(w and p for w, p in zip(warn, positive, strict=True)),
         fp=sum(w and not p for w, p in zip(warn, positive, strict=True)),
@@ -231,21 +232,21 @@ def judge_run(row: dict[str, Any], method: str) -> RunOutcome:
         tn=sum(not w and not p for w, p in zip(warn, positive, strict=True)),
     )
     contact = contact_time(row)
-    onset = next((truth["t"][k] for k in range(n) if warn[k] and on_course[k]), None)
+    onset = next((truth.t[k] for k in range(n) if warn[k] and on_course[k]), None)
     pipeline, _ = split_method(method)
     avail = available_times(row, pipeline)
     onset_latency = next(
         (avail[k] for k in range(n) if warn[k] and on_course[k] and avail[k] is not None), None
     )
-    scenario = row["scenario"]
+    scenario = row.scenario
     return RunOutcome(
-        id=row["id"],
-        family=row["family"],
-        kind=row.get("kind", "case"),
-        scale=row.get("scale", ""),
+        id=row.id,
+        family=row.family,
+        kind=row.kind,
+        scale=row.scale,
         case=run_case(row),
-        robot_speed=float(scenario["robot_speed"]),
-        horizon=float(scenario["horizon"]),
+        robot_speed=float(scenario.robot_speed),
+        horizon=float(scenario.horizon),
         collision_run=any(positive),
         contact_time=contact if any(positive) else None,
         warned=any(warn),
@@ -379,13 +380,13 @@ class CaseSummary:
         return Case(k + 1), float(said[k] / said.sum())
 
 
-def case_summary(rows: Sequence[dict[str, Any]], method: str) -> CaseSummary:
+def case_summary(rows: Sequence[RunResult], method: str) -> CaseSummary:
     confusion = np.zeros((9, 9), dtype=int)
     for row in rows:
         cols = _decisions(row, method)
         if not cols:
             continue
-        for truth_case, pred in zip(row["truth"]["case"], cols["case"], strict=True):
+        for truth_case, pred in zip(row.truth.case, cols.case, strict=True):
             if pred is not None:
                 confusion[truth_case - 1, pred - 1] += 1
     return CaseSummary(method, int(confusion.sum()), int(np.trace(confusion)), confusion)
@@ -413,7 +414,7 @@ class PositionSummary:
         return np.array([(errors <= r).mean() for r in radii])
 
 
-def position_summary(rows: Sequence[dict[str, Any]], method: str) -> PositionSummary:
+def position_summary(rows: Sequence[RunResult], method: str) -> PositionSummary:
     """Predicted foot point at frame k vs the true foot point at frame k + horizon / dt."""
     px_errors: list[float] = []
     m_errors: list[float] = []
@@ -421,16 +422,16 @@ def position_summary(rows: Sequence[dict[str, Any]], method: str) -> PositionSum
         cols = _decisions(row, method)
         if not cols:
             continue
-        truth = row["truth"]
-        ahead = int(round(row["scenario"]["horizon"] / row["scenario"]["dt"]))
-        n = len(truth["t"])
+        truth = row.truth
+        ahead = int(round(row.scenario.horizon / row.scenario.dt))
+        n = len(truth.t)
         for k in range(n):
-            pred = cols["foot"][k]
-            if pred is not None and k + ahead < n and truth["foot"][k + ahead] is not None:
-                true = truth["foot"][k + ahead]
+            pred = cols.foot[k]
+            if pred is not None and k + ahead < n and truth.foot[k + ahead] is not None:
+                true = truth.foot[k + ahead]
                 if None not in pred and None not in true:
                     px_errors.append(math.dist(pred, true))
-            ground, future = cols["ground"][k], truth["future"][k]
+            ground, future = cols.ground[k], truth.future[k]
             if ground is not None and future is not None and None not in ground + future:
                 m_errors.append(math.dist(ground, future))
     return PositionSummary(method, tuple(px_errors), tuple(m_errors))
@@ -445,13 +446,13 @@ class PhiSummary:
     pairs: tuple[tuple[float, float], ...] = field(repr=False)  # (true, measured)
 
 
-def phi_summary(rows: Sequence[dict[str, Any]], pipeline: str = MAIN) -> PhiSummary:
+def phi_summary(rows: Sequence[RunResult], pipeline: str = MAIN) -> PhiSummary:
     pairs = []
     for row in rows:
-        measured = row["pipelines"].get(pipeline, {}).get("phi")
-        if measured is None:
+        columns = row.pipelines.get(pipeline)
+        if columns is None:
             continue
-        for true, got in zip(row["truth"]["phi"], measured, strict=True):
+        for true, got in zip(row.truth.phi, columns.phi, strict=True):
             if true is not None and got is not None:
                 pairs.append((float(true), float(got)))
     if not pairs:
@@ -479,23 +480,23 @@ class FoundShare:
 
 
 def found_shares(
-    rows: Sequence[dict[str, Any]], pipeline: str = MAIN, min_visible: float = 0.5
+    rows: Sequence[RunResult], pipeline: str = MAIN, min_visible: float = 0.5
 ) -> tuple[FoundShare, FoundShare]:
     """Pose found share by distance (m) and by true apparent height (px)."""
     by_range = ([0] * (len(RANGE_BINS) - 1), [0] * (len(RANGE_BINS) - 1))
     by_height = ([0] * (len(HEIGHT_BINS) - 1), [0] * (len(HEIGHT_BINS) - 1))
     for row in rows:
-        found = row["pipelines"].get(pipeline, {}).get("found")
-        if found is None:
+        columns = row.pipelines.get(pipeline)
+        if columns is None:
             continue
-        truth = row["truth"]
-        for k, hit in enumerate(found):
-            visible = truth["visible"][k]
-            if not truth["in_frame"][k] or visible is None or visible < min_visible:
+        truth = row.truth
+        for k, hit in enumerate(columns.found):
+            visible = truth.visible[k]
+            if not truth.in_frame[k] or visible is None or visible < min_visible:
                 continue
             for (seen, got), edges, value in (
-                (by_range, RANGE_BINS, truth["range"][k]),
-                (by_height, HEIGHT_BINS, truth["height"][k]),
+                (by_range, RANGE_BINS, truth.range[k]),
+                (by_height, HEIGHT_BINS, truth.height[k]),
             ):
                 if value is None:
                     continue
@@ -510,22 +511,21 @@ def found_shares(
 
 
 def recall_by_range(
-    rows: Sequence[dict[str, Any]], method: str
+    rows: Sequence[RunResult], method: str
 ) -> tuple[tuple[float, ...], list[int], list[int]]:
     """Frame-level recall by true distance: (bin edges, positives, warned positives)."""
     pos = [0] * (len(RANGE_BINS) - 1)
     hit = [0] * (len(RANGE_BINS) - 1)
     for row in rows:
         cols = _decisions(row, method)
-        truth = row["truth"]
-        for k, positive in enumerate(truth["collision"]):
-            if not positive or truth["range"][k] is None:
+        truth = row.truth
+        for k, positive in enumerate(truth.collision):
+            distance = truth.range[k]
+            if not positive or distance is None:
                 continue
-            b = min(
-                int(np.searchsorted(RANGE_BINS, truth["range"][k], side="right")) - 1, len(pos) - 1
-            )
+            b = min(int(np.searchsorted(RANGE_BINS, distance, side="right")) - 1, len(pos) - 1)
             pos[b] += 1
-            hit[b] += int(bool(cols and cols["warn"][k]))
+            hit[b] += int(bool(cols and cols.warn[k]))
     return RANGE_BINS, pos, hit
 
 
@@ -537,11 +537,11 @@ class LatencySummary:
     p95: dict[str, float]
 
 
-def latency_summary(rows: Sequence[dict[str, Any]], pipeline: str = MAIN) -> LatencySummary:
+def latency_summary(rows: Sequence[RunResult], pipeline: str = MAIN) -> LatencySummary:
     values: dict[str, list[float]] = defaultdict(list)
     frames = 0
     for row in rows:
-        ms = row.get("timing", {}).get("ms", {}).get(pipeline)
+        ms = row.timing.ms.get(pipeline)
         if not ms:
             continue
         frames += len(ms["total"])
@@ -579,12 +579,12 @@ class SweepMetrics:
     codes: tuple[str, ...] = ()  # sim.runs.code_version of the runs ("unknown" before it existed)
 
 
-def _machine(row: dict[str, Any]) -> str:
-    info = row["timing"]["machine"]
-    return f"{info.get('cpu', '?')} ({info.get('cores', '?')} cores)"
+def _machine(row: RunResult) -> str:
+    info = row.timing.machine
+    return f"{info.cpu} ({info.cores if info.cores is not None else '?'} cores)"
 
 
-def compute(rows: Sequence[dict[str, Any]]) -> SweepMetrics:
+def compute(rows: Sequence[RunResult]) -> SweepMetrics:
     rows = dedupe(rows)
     all_methods = methods(rows)
     outcomes = {m: [judge_run(row, m) for row in rows] for m in all_methods}
@@ -595,14 +595,12 @@ def compute(rows: Sequence[dict[str, Any]]) -> SweepMetrics:
             for m in all_methods
         }
 
-    pipelines = [p for p in (MAIN, ABLATION) if any(p in r["pipelines"] for r in rows)]
-    sizes = sorted(
-        {f"{r['scenario']['camera']['width']}x{r['scenario']['camera']['height']}" for r in rows}
-    )
-    machines = sorted({_machine(r) for r in rows if "machine" in r.get("timing", {})})
+    pipelines = [p for p in (MAIN, ABLATION) if any(p in r.pipelines for r in rows)]
+    sizes = sorted({f"{r.scenario.camera.width}x{r.scenario.camera.height}" for r in rows})
+    machines = sorted({_machine(r) for r in rows})
     return SweepMetrics(
         rows=len(rows),
-        families=tuple(sorted({r["family"] for r in rows})),
+        families=tuple(sorted({r.family for r in rows})),
         methods=tuple(all_methods),
         outcomes=outcomes,
         overall={m: summarise(m, outcomes[m]) for m in all_methods},
@@ -615,8 +613,8 @@ def compute(rows: Sequence[dict[str, Any]]) -> SweepMetrics:
         phi={p: phi_summary(rows, p) for p in pipelines},
         found={p: found_shares(rows, p) for p in pipelines},
         latency={p: latency_summary(rows, p) for p in pipelines},
-        seeds=len({r["seed"] for r in rows}),
+        seeds=len({r.seed for r in rows}),
         frame_sizes=tuple(sizes),
         machines=tuple(machines),
-        codes=tuple(sorted({str(r.get("code") or UNKNOWN) for r in rows})),
+        codes=tuple(sorted({str(r.code or UNKNOWN) for r in rows})),
     )

@@ -25,6 +25,7 @@ from sim.analysis.metrics import (
     split_method,
     wilson,
 )
+from sim.runs.result import RunResult
 
 COLOURS = {"rules": "#1f77b4", "id3-tree": "#ff7f0e", "constant-velocity": "#2ca02c"}
 DPI = 110
@@ -153,7 +154,7 @@ def lead_time(m: SweepMetrics, path: Path, footer: str, methods: Sequence[str]) 
 
 
 def recall_by_distance(
-    m: SweepMetrics, rows: Sequence[dict], path: Path, footer: str, methods: Sequence[str]
+    m: SweepMetrics, rows: Sequence[RunResult], path: Path, footer: str, methods: Sequence[str]
 ) -> Path:
     fig = Figure(figsize=(8, 5), layout="constrained")
     ax = fig.add_subplot()
@@ -276,7 +277,7 @@ def found_share(m: SweepMetrics, path: Path, footer: str) -> Path:
 
 
 def write_all(
-    m: SweepMetrics, rows: Sequence[dict], out_dir: Path, footer: str, methods: Sequence[str]
+    m: SweepMetrics, rows: Sequence[RunResult], out_dir: Path, footer: str, methods: Sequence[str]
 ) -> list[Path]:
     """Every plot of the report; returns the paths written."""
     return [

@@ -25,6 +25,7 @@ from sim.analysis.metrics import (
     WarningSummary,
     split_method,
 )
+from sim.runs.result import RunResult
 
 
 def pct(value: float) -> str:
@@ -184,7 +185,9 @@ def goal_lines(m: SweepMetrics) -> list[str]:
     return out
 
 
-def write_report(m: SweepMetrics, rows: Sequence[dict], results: Path, out_dir: Path) -> Report:
+def write_report(
+    m: SweepMetrics, rows: Sequence[RunResult], results: Path, out_dir: Path
+) -> Report:
     """Write report.md and its plots into out_dir (created); returns what was written."""
     out_dir.mkdir(parents=True, exist_ok=True)
     footer = ran_on(m)

@@ -66,7 +66,8 @@ def _numbers(text: str, option: str) -> list[float]:
 
 def case_scenarios(cases: str, speeds: list[float]) -> list[Scenario]:
     from monopic.cases import Case
-    from sim.scenario.cases import place_case
+    from sim.scenario.cases import CasePlacement
+    from sim.scenario.families import PlacementError
 
     out = []
     for text in cases.split(","):
@@ -79,16 +80,18 @@ def case_scenarios(cases: str, speeds: list[float]) -> list[Scenario]:
         for v in speeds:
             if v <= 0:
                 raise UserError("--speeds: a crossing needs a moving robot (> 0 m/s)")
-            out.append(
-                place_case(
+            try:
+                placement = CasePlacement(
                     case,
                     distance=v * MEET_TIME,
                     robot_speed=v,
                     meet_time=MEET_TIME,
                     duration=MEET_TIME + 1.0,
-                    name=f"case{int(case)}@{v:g}",
                 )
-            )
+            except PlacementError as err:  # e.g. a robot speed beyond the placement's range
+                message = f"--speeds {v:g}: case {int(case)}: {err.field} {err.reason}"
+                raise UserError(message) from None
+            out.append(placement.scenario(name=f"case{int(case)}@{v:g}"))
     return out
 
 

@@ -15,11 +15,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "dataset",
         help="render simulated runs into a dataset (images, COCO keypoints, masks, truth)",
-        description="Render every run of a dataset spec into DIR. The spec is either a case "
-        "grid ([grid]: every combination of case placements) or a sweep spec ([[include]] "
-        "of scenario files, as `monopic sweep` reads it: the same runs, ids and seeds); see "
-        "scenarios/datasets/README.md. DIR gets JPEG images, COCO keypoint files for "
-        "BlazePose's 33 landmarks and COCO's 17 (boxes, visibility, RLE masks), PNG masks "
+        description="Render every run of a dataset spec into DIR. The spec is a sweep spec "
+        "([[include]] of scenario files, as `monopic sweep` reads it: the same runs, ids and "
+        "seeds; a grid over the nine cases sweeps path.case of "
+        "scenarios/datasets/case_grid.toml); see scenarios/datasets/README.md. DIR gets JPEG "
+        "images, COCO keypoint files for BlazePose's 33 landmarks and COCO's 17 (boxes, "
+        "visibility, RLE masks), PNG masks "
         "from MuJoCo's segmentation rendering, per-frame ground truth with case labels, the "
         "pipeline's features in the authors' CSV columns, and a README card. Prints a size "
         "estimate first. Deterministic for the spec; run it again on the same DIR to resume.",
@@ -28,7 +29,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "spec",
         type=Path,
         metavar="SPEC.toml",
-        help="case grid (scenarios/datasets/*.toml) or sweep spec (e.g. scenarios/sweeps/*.toml)",
+        help="a sweep spec: scenarios/datasets/*.toml, scenarios/sweeps/*.toml",
     )
     p.add_argument("--out", type=Path, required=True, metavar="DIR")
     p.add_argument("--estimate-only", action="store_true", help="print the size estimate and stop")

@@ -9,7 +9,6 @@ from typing import TYPE_CHECKING
 from tqdm import tqdm
 
 from monopic.cases import Case
-from monopic.cli.args import non_negative_float, positive_float
 from monopic.errors import UserError
 
 if TYPE_CHECKING:  # the simulator is imported when a command runs, not when the CLI starts
@@ -20,7 +19,7 @@ SCENARIO_HELP = """\
 SCENARIO is a case number 1-9 or its name (e.g. 5, case5, perpendicular-right), or
 `crossing` (an adult crossing into the robot's path; contact at 2.7 s unless it
 brakes), or a scenario file (scenarios/**/*.toml: its base scenario, without its sweep).
-Cases are placed by sim.scenario.cases.place_case; the options below set its parameters.
+Cases are placed by sim.scenario.cases.CasePlacement; the options below set its parameters.
 """
 
 
@@ -52,15 +51,23 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
+# CasePlacement's parameters the command offers (defaults and ranges are the placement's).
+CASE_OPTIONS = ("distance", "lateral_offset", "pedestrian_speed", "robot_speed", "duration", "seed")
+
+
 def add_case_options(p: argparse.ArgumentParser) -> None:
-    """place_case's parameters, for scenarios given as a case."""
+    """CasePlacement's parameters, for scenarios given as a case."""
+    from sim.scenario.cases import PLACEMENT_FIELDS, placement_help
+
     g = p.add_argument_group("case placement (SCENARIO given as a case)")
-    g.add_argument("--distance", type=float, default=8.0, help="m ahead where it crosses (8)")
-    g.add_argument("--lateral-offset", type=float, default=0.0, help="m to the left (0)")
-    g.add_argument("--pedestrian-speed", type=positive_float, default=1.4, help="m/s (1.4)")
-    g.add_argument("--robot-speed", type=non_negative_float, default=2.0, help="m/s (2)")
-    g.add_argument("--duration", type=positive_float, default=4.0, help="s (4)")
-    g.add_argument("--seed", type=int, default=0, help="gait phase seed (0)")
+    for name in CASE_OPTIONS:
+        f = PLACEMENT_FIELDS[name]
+        g.add_argument(
+            f"--{name.replace('_', '-')}",
+            type=int if f.type in (int, "int") else float,
+            default=f.default,
+            help=placement_help(name),
+        )
 
 
 def parse_case(text: str) -> Case | None:
@@ -80,7 +87,8 @@ def parse_case(text: str) -> Case | None:
 
 def resolve_scenario(text: str, args: argparse.Namespace) -> Scenario:
     """The Scenario named on the command line (see SCENARIO_HELP)."""
-    from sim.scenario.cases import default_crossing, place_case
+    from sim.scenario.cases import CasePlacement, default_crossing
+    from sim.scenario.families import PlacementError
     from sim.scenario.files import load
 
     if text.endswith(".toml") or Path(text).is_file():
@@ -94,17 +102,11 @@ def resolve_scenario(text: str, args: argparse.Namespace) -> Scenario:
             "'crossing' or an existing .toml file"
         )
     try:
-        return place_case(
-            case,
-            distance=args.distance,
-            lateral_offset=args.lateral_offset,
-            pedestrian_speed=args.pedestrian_speed,
-            robot_speed=args.robot_speed,
-            duration=args.duration,
-            seed=args.seed,
-        )
-    except ValueError as err:
-        raise UserError(f"scenario {text!r}: {err}") from None
+        placement = CasePlacement(case, **{name: getattr(args, name) for name in CASE_OPTIONS})
+    except PlacementError as err:
+        flag = f"--{err.field.replace('_', '-')}"
+        raise UserError(f"{flag} {err.value:g}: {err.reason}") from None
+    return placement.scenario()
 
 
 def run(args: argparse.Namespace) -> int:

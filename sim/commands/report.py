@@ -19,17 +19,14 @@ def run(args: argparse.Namespace) -> int:
     from monopic.errors import UserError
     from sim.analysis.metrics import compute
     from sim.analysis.report import ran_on, write_report
-    from sim.runs.results_file import read_rows
+    from sim.runs.results_file import read_results
 
     results: Path = args.results
     if not results.is_file():
         raise UserError(f"{results}: no such results file")
-    rows = list(read_rows(results))
+    rows = list(read_results(results))
     if not rows:
         raise UserError(f"{results}: no finished runs in it yet")
-    for number, row in enumerate(rows, start=1):
-        if row.get("schema") != 1 or "truth" not in row:
-            raise UserError(f"{results}:{number}: not a sweep result line (schema 1)")
     out = args.out or results.with_name(f"{results.stem}_report")
     if out.exists() and not out.is_dir():
         raise UserError(f"--out {out}: exists and is not a folder")

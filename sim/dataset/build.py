@@ -1,8 +1,7 @@
 """Synthetic datasets: scenario runs rendered into images, COCO keypoints, masks and truth rows.
 
-A dataset spec (see scenarios/datasets/README.md) is either a case grid ([grid]: every
-combination of sim.scenario.cases.place_case parameters is one run) or a sweep spec ([[include]]:
-the runs sim.runs.sweep expands it into, with the sweep's run ids, scenarios and seeds; the ids
+A dataset spec (see scenarios/datasets/README.md) is a sweep spec: the runs
+sim.runs.sweep expands it into, with the sweep's run ids, scenarios and seeds (the ids
 hold a slash, so the per-run files below nest a folder deeper). Every frame of a run is
 one image. For each run the folder gets:
 
@@ -25,9 +24,8 @@ visible, box from the mask, visibility 0 outside the image, 1 hidden behind anot
 object, 2 in view; RLE masks), frames.csv (one row per image), runs.csv and README.md
 (the card: what, how, counts, licence).
 
-Deterministic for a spec: the run seeds (the gait phase) derive from the spec's seed and
-the run's index (a sweep spec: as the sweep derives them), the renderer and the pose
-models are deterministic on one machine; only the measured-time columns of the features
+Deterministic for a spec: the run seeds (the gait phase) are the sweep's, the renderer
+and the pose models are deterministic on one machine; only the measured-time columns of the features
 (…Ms) differ between invocations.
 """
 
@@ -40,7 +38,7 @@ import math
 import shutil
 from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -57,6 +55,7 @@ from monopic.predict.rules import RulePredictor
 from sim.dataset.card import readme
 from sim.dataset.coco import SKELETONS, category, encode_mask, mask_box, select_keypoints
 from sim.dataset.spec import FORMAT_VERSION, JPEG_QUALITY, DatasetRun, DatasetSpec, expand
+from sim.runs.loop import Listener, LoopFrame, OnBoard, Progress, run_loop
 from sim.runs.sweep import SweepSpec
 from sim.scenario.spec import CameraSpec, Scenario
 from sim.world.ground_truth import GroundTruth
@@ -110,6 +109,78 @@ def _plain(value: object) -> object:
     raise TypeError(f"{type(value).__name__} is not JSON serialisable")
 
 
+FEATURES = "features"  # the on-board pipeline whose per-frame features the CSV holds
+
+
+@dataclass
+class FrameWriter(Listener):
+    """Writes each frame of a dataset run: image, mask, annotation, truth line, features row."""
+
+    run: DatasetRun
+    out: Path
+    world: World | None = None
+    images: list[dict[str, Any]] = field(default_factory=list)
+    annotations: list[dict[str, Any]] = field(default_factory=list)
+    truth_lines: list[str] = field(default_factory=list)
+    feature_rows: list[list[Any]] = field(default_factory=list)
+    found: int = 0
+
+    def start(self, world: World) -> None:
+        self.world = world
+
+    def frame(self, frame: LoopFrame) -> None:
+        assert self.world is not None and frame.step.frame is not None
+        run, out, k, truth = self.run, self.out, frame.index, frame.truth
+        scenario = run.scenario
+        cam = scenario.robot.camera
+        image_name = f"images/{run.id}/{k:04d}.jpg"
+        mask_name = f"masks/{run.id}/{k:04d}.png"
+        bgr = cv2.cvtColor(frame.step.frame.image, cv2.COLOR_RGB2BGR)
+        if not cv2.imwrite(str(out / image_name), bgr, [cv2.IMWRITE_JPEG_QUALITY, JPEG_QUALITY]):
+            raise OSError(f"cannot write {out / image_name}")
+        mask = self.world.pedestrian_mask()
+        cv2.imwrite(str(out / mask_name), mask.astype(np.uint8) * 255)
+        result = frame.results[FEATURES]
+        assert result is not None
+        self.found += int(result.pose.found)
+        if result.features is not None:
+            row = frame_row(result, 1.0 / scenario.dt, scenario.horizon)
+            if authors_finite(row):
+                self.feature_rows.append(row)
+        image_id = (run.index + 1) * 10000 + k
+        self.images.append(
+            {
+                "id": image_id,
+                "file_name": image_name,
+                "width": cam.width,
+                "height": cam.height,
+                "run": run.id,
+                "frame": k,
+                "time": round(frame.step.time, 6),
+                "mask_file": mask_name,
+            }
+        )
+        area = int(mask.sum())
+        if area > 0:
+            u0, v0, u1, v1 = truth.box
+            self.annotations.append(
+                {
+                    "id": image_id,
+                    "image_id": image_id,
+                    "category_id": 1,
+                    "iscrowd": 0,
+                    "area": area,
+                    "bbox": mask_box(mask),
+                    "amodal_bbox": _clipped_box(u0, v0, u1, v1, cam.width, cam.height),
+                    "segmentation": encode_mask(mask),
+                    "keypoints33": keypoints33(truth, cam.width, cam.height),
+                    "case": int(truth.case),
+                    "occluded": bool(truth.occluded),
+                }
+            )
+        self.truth_lines.append(_truth_line(run, k, image_name, mask_name, truth))
+
+
 def render_run(
     run: DatasetRun,
     out: Path,
@@ -127,92 +198,33 @@ def render_run(
         (out / sub / run.id).mkdir(parents=True)
     for sub in ("truth", "features", "runs"):  # a sweep's run ids nest: <scenario>/<draw>-…
         (out / sub / run.id).parent.mkdir(parents=True, exist_ok=True)
-    pipeline = dataset_pipeline(scenario)
-    images, annotations = [], []
-    truth_lines, feature_rows = [], []
-    contact_time = None
-    found = 0
+    writer = FrameWriter(run, out)
+    listeners: list[Listener] = [writer]
+    if on_frame is not None:
+        listeners.append(Progress(on_frame))
     context = kept.fitting(cam.width, cam.height) if kept is not None else None
     with World(scenario, render=True, render_context=context) as world:
-        step = world.reset()
-        for k in range(scenario.frames):
-            if k > 0:
-                step = world.step()
-            assert step.frame is not None
-            truth = step.truth
-            image_name = f"images/{run.id}/{k:04d}.jpg"
-            mask_name = f"masks/{run.id}/{k:04d}.png"
-            bgr = cv2.cvtColor(step.frame.image, cv2.COLOR_RGB2BGR)
-            if not cv2.imwrite(
-                str(out / image_name), bgr, [cv2.IMWRITE_JPEG_QUALITY, JPEG_QUALITY]
-            ):
-                raise OSError(f"cannot write {out / image_name}")
-            mask = world.pedestrian_mask()
-            cv2.imwrite(str(out / mask_name), mask.astype(np.uint8) * 255)
-            result = pipeline.process(step.frame)
-            found += int(result.pose.found)
-            if result.features is not None:
-                row = frame_row(result, 1.0 / scenario.dt, scenario.horizon)
-                if authors_finite(row):
-                    feature_rows.append(row)
-            image_id = (run.index + 1) * 10000 + k
-            images.append(
-                {
-                    "id": image_id,
-                    "file_name": image_name,
-                    "width": cam.width,
-                    "height": cam.height,
-                    "run": run.id,
-                    "frame": k,
-                    "time": round(step.time, 6),
-                    "mask_file": mask_name,
-                }
-            )
-            area = int(mask.sum())
-            if area > 0:
-                kp = keypoints33(truth, cam.width, cam.height)
-                u0, v0, u1, v1 = truth.box
-                annotations.append(
-                    {
-                        "id": image_id,
-                        "image_id": image_id,
-                        "category_id": 1,
-                        "iscrowd": 0,
-                        "area": area,
-                        "bbox": mask_box(mask),
-                        "amodal_bbox": _clipped_box(u0, v0, u1, v1, cam.width, cam.height),
-                        "segmentation": encode_mask(mask),
-                        "keypoints33": kp,
-                        "case": int(truth.case),
-                        "occluded": bool(truth.occluded),
-                    }
-                )
-            truth_lines.append(_truth_line(run, k, image_name, mask_name, truth))
-            if on_frame is not None:
-                on_frame(k)
-            if truth.contact:
-                contact_time = truth.time
-                break
+        onboard = OnBoard(FEATURES, dataset_pipeline(scenario))
+        end = run_loop(world, [onboard], listeners, frames=scenario.frames)
     with atomic_path(out / "truth" / f"{run.id}.jsonl") as tmp:
-        tmp.write_text("\n".join(truth_lines) + "\n", encoding="utf-8")
+        tmp.write_text("\n".join(writer.truth_lines) + "\n", encoding="utf-8")
     buf = io.StringIO()
-    writer = csv.writer(buf, lineterminator="\n")
-    writer.writerow(FEATURE_COLUMNS)
-    writer.writerows(feature_rows)
+    csv_writer = csv.writer(buf, lineterminator="\n")
+    csv_writer.writerow(FEATURE_COLUMNS)
+    csv_writer.writerows(writer.feature_rows)
     write_text_atomically(out / "features" / f"{run.id}.csv", buf.getvalue())
-    frames = len(images)
     record = {
         "format": FORMAT_VERSION,
         "id": run.id,
         "index": run.index,
         "scenario": scenario.name,
         "params": run.params,
-        "frames": frames,
-        "pose_found": found,
-        "feature_rows": len(feature_rows),
-        "contact_time": contact_time,
-        "images": images,
-        "annotations": annotations,
+        "frames": len(writer.images),
+        "pose_found": writer.found,
+        "feature_rows": len(writer.feature_rows),
+        "contact_time": end.contact_time,
+        "images": writer.images,
+        "annotations": writer.annotations,
     }
     record["bytes"] = _run_bytes(out, run.id)
     write_text_atomically(out / "runs" / f"{run.id}.json", json.dumps(record, default=_plain))
@@ -430,15 +442,13 @@ def _frames_csv(out: Path, records: list[dict[str, Any]]) -> tuple[str, Counter]
     return buf.getvalue(), cases
 
 
-GRID_RUN_COLUMNS = ("case", "distance", "lateral_offset", "pedestrian_speed", "robot_speed",
-                    "angle_deg", "repeat", "seed")  # fmt: skip
 SWEEP_RUN_COLUMNS = ("family", "kind", "scale", "parameters", "seed")  # parameters: JSON
 
 
 def _runs_csv(spec: DatasetSpec, records: list[dict[str, Any]]) -> str:
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
-    keys = SWEEP_RUN_COLUMNS if isinstance(spec.source, SweepSpec) else GRID_RUN_COLUMNS
+    keys = SWEEP_RUN_COLUMNS
     w.writerow(("run", *keys, "frames", "annotated", "pose_found", "contact_time", "bytes"))
     for r in records:
         p = r["params"]

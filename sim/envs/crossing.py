@@ -40,6 +40,7 @@ from highway_env.envs.common.observation import ObservationType
 
 from sim.scenario.cases import default_crossing
 from sim.scenario.spec import Scenario
+from sim.world.ground_truth import pedestrian_passed
 from sim.world.robot import Robot
 from sim.world.world import World, WorldStep
 
@@ -177,9 +178,10 @@ class PedestrianCrossingEnv(AbstractEnv):
         )
 
     def _pedestrian_passed(self) -> bool:
-        truth = self.world_step.truth
-        clearance = self.scenario.robot.length / 2 + self.scenario.pedestrian.footprint
-        return bool(truth.position_robot[0] < -clearance)
+        scenario = self.scenario
+        return pedestrian_passed(
+            self.world_step.truth, scenario.robot.length, scenario.pedestrian.footprint
+        )
 
     def _is_terminated(self) -> bool:
         return bool(self.world_step.truth.contact or self._pedestrian_passed())

@@ -1,7 +1,10 @@
 """The closed loop: the robot brakes when the pipeline warns, late by the pipeline's own latency.
 
-Each run steps the gymnasium environment (sim.envs.crossing, `monopic/PedestrianCrossing-v0`) one
-frame at a time. A policy turns each frame into a brake decision:
+Each run is the one run loop (sim.runs.loop) with a brake controller, ending as the
+gymnasium environment `monopic/PedestrianCrossing-v0` ends an episode (contact, the
+pedestrian behind the robot, or the scenario's duration) and seeded as it seeds the
+world, so a run equals that environment's episode. A policy turns each frame into a
+brake decision:
 
 - "none": never brakes (the baseline the contacts are counted against);
 - "truth": brakes when the ground truth says the footprints meet within the horizon (an
@@ -37,10 +40,10 @@ import numpy as np
 from monopic.pipeline import Pipeline
 from monopic.predict.base import Mode
 from monopic.predict.registry import make_predictor
-from sim.envs import ENV_ID
 from sim.recording.sim_recording import SimRecording
+from sim.runs.loop import Listener, LoopEnd, LoopFrame, OnBoard, Progress, run_loop
 from sim.scenario.spec import Scenario
-from sim.world.ground_truth import footprint_gap
+from sim.world.ground_truth import footprint_gap, pedestrian_passed
 from sim.world.world import World, WorldStep
 
 NO_BRAKE = "none"
@@ -113,6 +116,9 @@ class LatencyBrake:
         return -self.deceleration if self.braking(index) else 0.0
 
 
+POLICY = "policy"  # the on-board pipeline's name in the loop
+
+
 def policy_pipeline(scenario: Scenario, policy: str) -> Pipeline:
     """A pipeline whose primary (only) predictor is the policy's, e.g. 'rules/ground'."""
     from sim.runs.pipelines import scenario_pipeline
@@ -121,6 +127,85 @@ def policy_pipeline(scenario: Scenario, policy: str) -> Pipeline:
     if mode not in {m.value for m in Mode}:
         raise ValueError(f"policy {policy!r}: expected 'none', 'truth' or PREDICTOR/MODE")
     return scenario_pipeline(scenario, [make_predictor(name, Mode(mode))])
+
+
+def world_seed(seed: int) -> int:
+    """The world's seed for a closed-loop seed, drawn as the gymnasium environment draws it
+    on reset(seed=seed), so a closed-loop run and that environment episode are the same."""
+    rng, _ = gymnasium.utils.seeding.np_random(seed)
+    return int(rng.integers(2**31 - 1))
+
+
+@dataclass
+class BrakeController:
+    """The policy's warning on each frame, turned into the brake command (LatencyBrake)."""
+
+    policy: str
+    brake: LatencyBrake
+    latency_ms: float | None
+    latencies: list[float] = field(default_factory=list)
+    warned_frames: int = 0
+    first_warning_time: float | None = None
+
+    def action(self, frame: LoopFrame) -> float:
+        truth = frame.truth
+        result = frame.results.get(POLICY)
+        if result is not None:
+            warned = bool(result.warning is not None and result.warning.collision)
+            measured = result.stage_ms["total"]
+            self.latencies.append(measured)
+            latency = (measured if self.latency_ms is None else self.latency_ms) / 1e3
+        elif self.policy == ORACLE:
+            warned = truth.collision
+            latency = 0.0 if self.latency_ms is None else self.latency_ms / 1e3
+        else:
+            warned, latency = False, 0.0
+        self.warned_frames += int(warned)
+        if warned and self.first_warning_time is None:
+            self.first_warning_time = truth.time
+        self.brake.observe(frame.index, warned, latency)
+        return self.brake.action(frame.index)
+
+
+@dataclass
+class LoopLog(Listener):
+    """What a closed-loop run amounts to: gaps, contact, when the brake acted (and the .rrd)."""
+
+    footprint: float
+    policy: str
+    recording: SimRecording | None = None
+    min_gap: float = math.inf
+    contact_time: float | None = None
+    impact_speed: float | None = None
+    brake_time: float | None = None
+    start_speed: float | None = None
+    final_speed: float = 0.0
+    frames: int = 0
+
+    def frame(self, frame: LoopFrame) -> None:
+        truth = frame.truth
+        if self.start_speed is None:
+            self.start_speed = truth.robot.speed
+        self.min_gap = min(self.min_gap, footprint_gap(truth, self.footprint))
+        if truth.contact and self.contact_time is None:
+            self.contact_time, self.impact_speed = truth.time, truth.robot.speed
+        if self.recording is not None:
+            self.recording.log_step(frame.step, frame.results.get(POLICY))
+            self.recording.log_series("brake/command", frame.action)
+            if frame.action and self.brake_time is None:
+                self.recording.log_event(
+                    f"BRAKE at {-frame.action:g} m/s^2 from this frame ({self.policy})", "WARN"
+                )
+        if frame.action and self.brake_time is None:
+            self.brake_time = truth.time
+
+    def end(self, end: LoopEnd) -> None:
+        # The run ends on contact, or at the first state after which nothing can happen
+        # (the pedestrian behind the robot, or time up): that state's gap counts too.
+        if end.reason == "until":
+            self.min_gap = min(self.min_gap, footprint_gap(end.final.truth, self.footprint))
+        self.frames = end.frames + (end.reason == "until")
+        self.final_speed = end.final.truth.robot.speed
 
 
 def run_closed_loop(
@@ -137,106 +222,51 @@ def run_closed_loop(
     `latency_ms` None applies the pipeline's measured latency per frame (the oracle has
     none); a number applies that fixed latency instead. `rrd` records the run.
     """
-    fps = round(1.0 / scenario.dt)
-    env = gymnasium.make(
-        ENV_ID,
-        config={"scenario": scenario, "simulation_frequency": fps, "policy_frequency": fps},
+    onboard = []
+    if policy not in (NO_BRAKE, ORACLE):
+        onboard.append(OnBoard(POLICY, policy_pipeline(scenario, policy)))
+    controller = BrakeController(
+        policy, LatencyBrake(scenario.dt, scenario.robot.max_deceleration), latency_ms
     )
-    try:
-        env.reset(seed=seed)
-        world: World = env.unwrapped.world
-        pipeline = None if policy in (NO_BRAKE, ORACLE) else policy_pipeline(scenario, policy)
-        brake = LatencyBrake(scenario.dt, scenario.robot.max_deceleration)
-        with SimRecording(rrd, world) if rrd is not None else nullcontext() as recording:
-            return _loop(env, world, scenario, policy, pipeline, brake, latency_ms, recording,
-                         seed, on_frame)  # fmt: skip
-    finally:
-        env.close()
+    robot, footprint = scenario.robot, scenario.pedestrian.footprint
 
-
-def _loop(
-    env: gymnasium.Env,
-    world: World,
-    scenario: Scenario,
-    policy: str,
-    pipeline: Pipeline | None,
-    brake: LatencyBrake,
-    latency_ms: float | None,
-    recording: SimRecording | None,
-    seed: int,
-    on_frame: Callable[[int], None] | None,
-) -> LoopOutcome:
-    step: WorldStep | None = world.last
-    assert step is not None
-    start_speed = step.truth.robot.speed
-    min_gap = math.inf
-    latencies: list[float] = []
-    warned_frames = 0
-    first_warning_time = brake_time = None
-    contact_time = impact_speed = None
-    k = 0
-    while True:
-        truth = step.truth
-        min_gap = min(min_gap, footprint_gap(truth, scenario.pedestrian.footprint))
-        result = None
-        if truth.contact:
-            contact_time, impact_speed = truth.time, truth.robot.speed
-        if pipeline is not None:
-            assert step.frame is not None
-            result = pipeline.process(step.frame)
-            warned = bool(result.warning is not None and result.warning.collision)
-            measured = result.stage_ms["total"]
-            latencies.append(measured)
-            latency = (measured if latency_ms is None else latency_ms) / 1e3
-        elif policy == ORACLE:
-            warned = truth.collision
-            latency = 0.0 if latency_ms is None else latency_ms / 1e3
-        else:
-            warned, latency = False, 0.0
-        warned_frames += int(warned)
-        if warned and first_warning_time is None:
-            first_warning_time = truth.time
-        brake.observe(k, warned, latency)
-        action = brake.action(k)
-        if recording is not None:
-            recording.log_step(step, result)
-            recording.log_series("brake/command", action)
-            if action and brake_time is None:
-                recording.log_event(
-                    f"BRAKE at {-action:g} m/s^2 from this frame ({policy})", "WARN"
-                )
-        if action and brake_time is None:
-            brake_time = truth.time
-        if on_frame is not None:
-            on_frame(k)
-        if truth.contact:
-            break
-        _, _, terminated, truncated, _ = env.step(np.array([action], dtype=np.float32))
-        k += 1
-        step = world.last
-        assert step is not None
+    def over(step: WorldStep) -> bool:  # as the gymnasium environment ends an episode
         if step.truth.contact:
-            continue  # the top of the loop records the contact and stops
-        if terminated or truncated:  # the pedestrian is behind the robot, or time is up
-            min_gap = min(min_gap, footprint_gap(step.truth, scenario.pedestrian.footprint))
-            break
-    last = step.truth
+            return False  # a contact frame is processed, then the loop stops
+        passed = pedestrian_passed(step.truth, robot.length, footprint)
+        return passed or step.index >= scenario.frames
+
+    with World(scenario, render=True) as world:
+        recording = SimRecording(rrd, world) if rrd is not None else None
+        with recording if recording is not None else nullcontext():
+            log = LoopLog(footprint, policy, recording)
+            listeners: list[Listener] = [log]
+            if on_frame is not None:
+                listeners.append(Progress(on_frame))
+            run_loop(
+                world,
+                onboard,
+                listeners,
+                controller=controller,
+                until=over,
+                seed=world_seed(seed),
+            )
     return LoopOutcome(
         scenario=scenario.name,
         policy=policy,
         seed=seed,
-        frames=k + 1,
-        contact=contact_time is not None,
-        contact_time=contact_time,
-        impact_speed=impact_speed,
-        min_gap=min_gap,
-        first_warning_time=first_warning_time,
-        brake_time=brake_time,
-        warned_frames=warned_frames,
-        start_speed=start_speed,
-        final_speed=last.robot.speed,
-        latencies_ms=tuple(latencies),
-        delays=tuple(brake.delays),
+        frames=log.frames,
+        contact=log.contact_time is not None,
+        contact_time=log.contact_time,
+        impact_speed=log.impact_speed,
+        min_gap=log.min_gap,
+        first_warning_time=controller.first_warning_time,
+        brake_time=log.brake_time,
+        warned_frames=controller.warned_frames,
+        start_speed=log.start_speed if log.start_speed is not None else robot.speed,
+        final_speed=log.final_speed,
+        latencies_ms=tuple(controller.latencies),
+        delays=tuple(controller.brake.delays),
     )
 
 

@@ -70,7 +70,7 @@ def work(spec: RunSpec, kept: KeptRenderContext | None = None) -> dict[str, Any]
     try:
         camera = spec.scenario.robot.camera
         context = kept.fitting(camera.width, camera.height) if kept is not None else None
-        return run(spec, render_context=context)
+        return run(spec, render_context=context).to_json()
     except Exception:  # noqa: BLE001 - reported per run; the sweep goes on
         return {"id": spec.id, "error": traceback.format_exc()}
 

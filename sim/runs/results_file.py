@@ -24,6 +24,7 @@ from typing import Any
 from monopic.closing import Closing
 from monopic.errors import UserError
 from sim.runs.code_version import UNKNOWN
+from sim.runs.result import RunResult
 
 
 @dataclass(frozen=True)
@@ -91,6 +92,12 @@ def read_rows(path: Path) -> Iterator[dict[str, Any]]:
     for raw in data.split(b"\n"):
         if raw:
             yield json.loads(raw)
+
+
+def read_results(path: Path) -> Iterator[RunResult]:
+    """Every complete result line as a record; a line that does not fit names its number."""
+    for number, row in enumerate(read_rows(path), start=1):
+        yield RunResult.from_json(row, f"{path}:{number}")
 
 
 class ResultsWriter(Closing):

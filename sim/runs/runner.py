@@ -1,14 +1,10 @@
-"""One run: a scenario stepped through World, its frames through the real pipeline, side by side.
+"""One sweep run: a scenario through the run loop, the real pipeline and its ablation side by side.
 
 The pipeline sees only each Frame (pixels, timestamp, the robot's own state); the runner
-alone holds the ground truth and writes both into one record per frame. The one
-deliberate exception is the ablation: a second pipeline fed the true crop around the
-pedestrian (`region=`), so that pose errors and decision errors can be told apart.
-
-A run's result is one JSON-ready dict (a line of the sweep's results file): the
-scenario's parameters, then per-frame columns (truth, each pipeline's features and every
-predictor's decisions). Measured times live under "timing" only, so everything else is
-identical whichever machine or executor ran it.
+alone holds the ground truth and writes both into one record (sim.runs.result.RunResult,
+a line of the sweep's results file). The one deliberate exception is the ablation: a
+second pipeline fed the true crop around the pedestrian, so that pose errors and
+decision errors can be told apart.
 """
 
 from __future__ import annotations
@@ -19,21 +15,28 @@ import platform
 import time
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 
-from monopic.pipeline import FrameResult
 from monopic.pose.region import Region
+from sim.runs.columns import PipelineRecorder, TruthRecorder
+from sim.runs.loop import Listener, OnBoard, Progress, StepTimes, run_loop
 from sim.runs.pipelines import make_pipeline
+from sim.runs.result import (
+    ABLATION,
+    MAIN,
+    CameraSummary,
+    Machine,
+    RunResult,
+    ScenarioSummary,
+    Timing,
+)
 from sim.runs.run_spec import RunSpec
 from sim.scenario.spec import Scenario
 from sim.world.ground_truth import GroundTruth
 from sim.world.render import RenderContext
 from sim.world.world import World
 
-SCHEMA = 1
-STAGES = ("pose", "detect", "landmarks", "features", "predict", "warning", "total")
 HIP_LANDMARKS = (23, 24)
 SHOULDER_LANDMARKS = (11, 12)
 
@@ -55,131 +58,31 @@ def truth_region(truth: GroundTruth) -> Region | None:
     return region if region.valid else None
 
 
-def _r(value: float | None, digits: int) -> float | None:
-    """Rounded for compact lines; None for missing or non-finite values."""
-    if value is None:
-        return None
-    value = float(value)
-    return round(value, digits) if math.isfinite(value) else None
-
-
-def _pt(values: Any, digits: int) -> list[float | None] | None:
-    if values is None:
-        return None
-    out = [_r(v, digits) for v in values]
-    return None if all(v is None for v in out) else out
-
-
-class PipelineLog:
-    """Per-frame columns of one pipeline's outputs (decisions by predictor key)."""
-
-    def __init__(self) -> None:
-        self.found: list[int] = []
-        self.phi: list[float | None] = []
-        self.foot: list[Any] = []
-        self.height: list[float | None] = []
-        self.detector_runs: list[int] = []
-        self.ms: dict[str, list[float | None]] = {s: [] for s in STAGES}
-        self.decisions: dict[str, dict[str, list[Any]]] = {}
-        self.frames = 0
-
-    def add(self, result: FrameResult | None) -> None:
-        """One frame's result (None: the pipeline was not run on this frame)."""
-        k = self.frames
-        self.frames += 1
-        feats = result.features if result is not None else None
-        self.found.append(int(result is not None and result.pose.found))
-        self.phi.append(_r(feats.phi, 2) if feats else None)
-        self.foot.append(_pt(feats.foot, 1) if feats else None)
-        self.height.append(_r(feats.apparent_height, 1) if feats else None)
-        self.detector_runs.append(result.pose.detector_runs if result is not None else 0)
-        for stage in STAGES:
-            ms = result.stage_ms.get(stage) if result is not None else None
-            self.ms[stage].append(_r(ms, 2))
-        for d in result.decisions if result is not None else ():
-            cols = self.decisions.setdefault(
-                d.predictor, {"warn": [], "case": [], "foot": [], "ground": [], "ttc": []}
-            )
-            for col in cols.values():  # frames before this predictor's first decision
-                col.extend([None] * (k - len(col)))
-            cols["warn"].append(int(d.warning.collision))
-            cols["case"].append(int(d.prediction.case))
-            cols["foot"].append(_pt(d.prediction.foot, 1))
-            cols["ground"].append(_pt(d.prediction.ground, 3))
-            cols["ttc"].append(_r(d.warning.time_to_contact, 3))
-
-    def outputs(self) -> dict[str, Any]:
-        for cols in self.decisions.values():
-            for col in cols.values():
-                col.extend([None] * (self.frames - len(col)))
-        return {
-            "found": self.found,
-            "phi": self.phi,
-            "foot": self.foot,
-            "height": self.height,
-            "detector_runs": self.detector_runs,
-            "decisions": self.decisions,
-        }
-
-
-class TruthLog:
-    """Per-frame columns of the ground truth the metrics need."""
-
-    def __init__(self) -> None:
-        self.cols: dict[str, list[Any]] = {
-            k: []
-            for k in (
-                "t", "ttc", "collision", "contact", "case", "phi", "range", "forward",
-                "lateral", "height", "in_frame", "visible", "occluded", "foot", "future",
-                "robot_speed",
-            )
-        }  # fmt: skip
-
-    def add(self, truth: GroundTruth) -> None:
-        c = self.cols
-        c["t"].append(_r(truth.time, 4))
-        c["ttc"].append(_r(truth.time_to_collision, 3))
-        c["collision"].append(int(truth.collision))
-        c["contact"].append(int(truth.contact))
-        c["case"].append(int(truth.case))
-        c["phi"].append(_r(truth.phi, 2))
-        c["range"].append(_r(float(np.linalg.norm(truth.position_robot)), 2))
-        c["forward"].append(_r(truth.position_robot[0], 2))
-        c["lateral"].append(_r(truth.position_robot[1], 2))
-        c["height"].append(_r(truth.apparent_height, 1))
-        c["in_frame"].append(int(truth.in_frame))
-        c["visible"].append(_r(truth.visible_fraction, 2))
-        c["occluded"].append(int(truth.occluded))
-        c["foot"].append(_pt(truth.foot_px, 1))
-        c["future"].append(_pt(truth.future_position_robot, 3))
-        c["robot_speed"].append(_r(truth.robot.speed, 3))
-
-
-def scenario_summary(s: Scenario) -> dict[str, Any]:
+def scenario_summary(s: Scenario) -> ScenarioSummary:
     cam = s.robot.camera
-    return {
-        "name": s.name,
-        "case": int(s.case) if s.case is not None else None,
-        "robot_speed": s.robot.speed,
-        "robot_width": s.robot.width,
-        "robot_length": s.robot.length,
-        "horizon": s.horizon,
-        "dt": s.dt,
-        "duration": s.duration,
-        "camera": {
-            "width": cam.width,
-            "height": cam.height,
-            "vertical_fov_deg": cam.vertical_fov_deg,
-            "mount_height": cam.mount_height,
-            "pitch_deg": cam.pitch_deg,
-        },
-        "pedestrian_height": s.pedestrian.looks.height,
-        "pedestrian_speed": s.pedestrian.speed,
-        "occluders": len(s.scene.occluders),
-    }
+    return ScenarioSummary(
+        name=s.name,
+        case=int(s.case) if s.case is not None else None,
+        robot_speed=s.robot.speed,
+        robot_width=s.robot.width,
+        robot_length=s.robot.length,
+        horizon=s.horizon,
+        dt=s.dt,
+        duration=s.duration,
+        camera=CameraSummary(
+            width=cam.width,
+            height=cam.height,
+            vertical_fov_deg=cam.vertical_fov_deg,
+            mount_height=cam.mount_height,
+            pitch_deg=cam.pitch_deg,
+        ),
+        pedestrian_height=s.pedestrian.looks.height,
+        pedestrian_speed=s.pedestrian.speed,
+        occluders=len(s.scene.occluders),
+    )
 
 
-def machine() -> dict[str, Any]:
+def machine() -> Machine:
     """What ran it, for the report's 'ran on' line."""
     cpu = platform.processor() or platform.machine()
     try:
@@ -189,86 +92,68 @@ def machine() -> dict[str, Any]:
             )
     except OSError:
         pass
-    return {"host": platform.node(), "cpu": cpu, "cores": os.cpu_count()}
+    return Machine(host=platform.node(), cpu=cpu, cores=os.cpu_count())
 
 
 def run(
     spec: RunSpec,
     on_frame: Callable[[int], None] | None = None,
     render_context: RenderContext | None = None,
-) -> dict[str, Any]:
-    """Run one scenario through the pipeline(s); returns its result line (a dict).
+) -> RunResult:
+    """Run one scenario through the pipeline(s); returns its result record.
 
     A worker running many scenarios lends each the same `render_context` (sim.world.render).
     """
     scenario = spec.scenario
     start = time.perf_counter()
-    main = make_pipeline(scenario)
-    ablation = make_pipeline(scenario, ablation=True) if spec.ablation else None
-    truth_log, main_log = TruthLog(), PipelineLog()
-    crop_log = PipelineLog() if ablation is not None else None
-    sim_ms: list[float] = []
-    contact_time = None
+    onboard = [OnBoard(MAIN, make_pipeline(scenario))]
+    if spec.ablation:
+        onboard.append(OnBoard(ABLATION, make_pipeline(scenario, ablation=True), truth_region))
+    truth = TruthRecorder()
+    recorders = {board.name: PipelineRecorder(board.name) for board in onboard}
+    times = StepTimes()
+    listeners: list[Listener] = [truth, *recorders.values(), times]
     recording_path = None
     with World(scenario, render=True, render_context=render_context) as world:
         recording = _start_recording(spec, world)
-        t0 = time.perf_counter()
-        step = world.reset()
-        for k in range(scenario.frames):
-            if k > 0:
-                t0 = time.perf_counter()
-                step = world.step()
-            sim_ms.append((time.perf_counter() - t0) * 1e3)
-            assert step.frame is not None
-            truth_log.add(step.truth)
-            result = main.process(step.frame)
-            main_log.add(result)
-            if recording is not None:
-                recording.log_step(step, result)
-            if ablation is not None and crop_log is not None:
-                region = truth_region(step.truth)
-                crop_log.add(ablation.process(step.frame, region) if region else None)
-            if on_frame is not None:
-                on_frame(k)
-            if step.truth.contact:
-                contact_time = step.truth.time
-                if spec.stop_at_contact:
-                    break
+        if recording is not None:
+            from sim.runs.record import Recorder
+
+            listeners.append(Recorder(recording))
+        if on_frame is not None:
+            listeners.append(Progress(on_frame))
+        end = run_loop(
+            world, onboard, listeners, frames=scenario.frames, stop_at_contact=spec.stop_at_contact
+        )
         if recording is not None:
             if spec.record == "all" or recording.went_wrong():
                 recording.close()
                 recording_path = recording_name(spec)
             else:
                 recording.abort()
-    pipelines = {"main": main_log.outputs()}
-    timing_ms = {"main": main_log.ms}
-    if crop_log is not None:
-        pipelines["gtcrop"] = crop_log.outputs()
-        timing_ms["gtcrop"] = crop_log.ms
-    return {
-        "schema": SCHEMA,
-        "id": spec.id,
-        "sweep": spec.sweep,
-        "family": spec.family or scenario.family,
-        "file": spec.file,
-        "kind": spec.kind,
-        "scale": spec.scale,
-        "params": spec.params,
-        "seed": scenario.seed,
-        "code": spec.code or None,
-        "scenario": scenario_summary(scenario),
-        "frames": len(truth_log.cols["t"]),
-        "contact_time": contact_time,
-        "recording": recording_path,
-        "truth": truth_log.cols,
-        "pipelines": pipelines,
-        "timing": {
-            "wall_s": round(time.perf_counter() - start, 3),
-            "sim_ms": [round(v, 2) for v in sim_ms],
-            "ms": timing_ms,
-            "machine": machine(),
-        },
-    }
+    return RunResult(
+        id=spec.id,
+        sweep=spec.sweep,
+        family=spec.family or scenario.family,
+        file=spec.file,
+        kind=spec.kind,
+        scale=spec.scale,
+        params=spec.params,
+        seed=scenario.seed,
+        code=spec.code or None,
+        scenario=scenario_summary(scenario),
+        frames=end.frames,
+        contact_time=end.contact_time,
+        recording=recording_path,
+        truth=truth.columns,
+        pipelines={name: r.finished() for name, r in recorders.items()},
+        timing=Timing(
+            wall_s=round(time.perf_counter() - start, 3),
+            sim_ms=[round(v, 2) for v in times.ms],
+            ms={name: r.ms for name, r in recorders.items()},
+            machine=machine(),
+        ),
+    )
 
 
 def _start_recording(spec: RunSpec, world: World):
@@ -287,8 +172,3 @@ def _start_recording(spec: RunSpec, world: World):
 def recording_name(spec: RunSpec) -> str:
     """The run's recording, relative to the sweep's recordings folder (ids nest by family)."""
     return f"{spec.id}.rrd"
-
-
-def deterministic_part(result: dict[str, Any]) -> dict[str, Any]:
-    """The result without measured times: equal whichever executor or machine ran it."""
-    return {k: v for k, v in result.items() if k != "timing"}

@@ -154,14 +154,20 @@ def expand_spec(spec: SweepSpec) -> list[RunSpec]:
                 combos = list(expand(sweep, file.name))
             except ValueError as err:
                 raise ScenarioFileError(path, "sweep", include.sampling, str(err)) from None
+            drawn: set[tuple[str, int]] = set()
             for index, params in enumerate(combos):
-                probe = file.scenario(params, name=file.name, seed=0)
+                built = file.scenario(params, name=file.name)
+                probe = replace(built, seed=0)
                 digest = hashlib.sha1(repr(probe).encode()).hexdigest()[:8]
                 rid = run_id(file, index, digest)
-                if rid in seen:
+                # The same scenario twice (e.g. a walking speed swept for a person who
+                # stands) is one run: its results would be identical. A swept `seed` makes
+                # repeats: the run's seed derives from it.
+                if rid in seen or (digest, built.seed) in drawn:
                     continue
                 seen.add(rid)
-                seed = (file.base.seed + zlib.crc32(f"{file.name}:{digest}".encode())) % 2**31
+                drawn.add((digest, built.seed))
+                seed = (built.seed + zlib.crc32(f"{file.name}:{digest}".encode())) % 2**31
                 runs.append(
                     RunSpec(
                         id=rid,

@@ -22,9 +22,12 @@ change.
 from __future__ import annotations
 
 import math
-from dataclasses import replace
+from collections.abc import Mapping
+from dataclasses import dataclass, field, fields, replace
+from typing import Any
 
 from monopic.cases import GROUND_DEAD_ZONE_MPS, SECTOR_RATIO, Case
+from sim.scenario.families import PlacementError
 from sim.scenario.spec import MannequinSpec, PedestrianSpec, RobotSpec, Scenario, SceneSpec
 
 OBLIQUE_RANGE_DEG = (
@@ -35,12 +38,6 @@ OBLIQUE_RANGE_DEG = (
 
 def case_heading_deg(case: Case, angle_deg: float = 45.0, facing_deg: float = 180.0) -> float:
     """Walking direction of a case relative to the robot's heading, degrees CCW."""
-    lo, hi = OBLIQUE_RANGE_DEG
-    if case.lateral != 0 and case.depth != 0 and not lo < angle_deg < hi:
-        raise ValueError(
-            f"an oblique case needs angle_deg strictly between {lo:.1f} and {hi:.1f} "
-            f"degrees from the robot's heading, got {angle_deg}"
-        )
     return {
         Case.OBLIQUE_RIGHT_AWAY: -angle_deg,
         Case.OBLIQUE_LEFT_AWAY: angle_deg,
@@ -54,78 +51,139 @@ def case_heading_deg(case: Case, angle_deg: float = 45.0, facing_deg: float = 18
     }[case]
 
 
-def place_case(
-    case: Case,
-    distance: float = 8.0,
-    lateral_offset: float = 0.0,
-    pedestrian_speed: float = 1.4,
-    robot_speed: float = 2.0,
-    angle_deg: float = 45.0,
-    meet_time: float | None = None,
-    facing_deg: float = 180.0,
-    duration: float = 4.0,
-    looks: MannequinSpec | None = None,
-    robot: RobotSpec | None = None,
-    scene: SceneSpec | None = None,
-    horizon: float = 1.0,
-    dt: float = 1.0 / 15.0,
-    seed: int = 0,
-    name: str | None = None,
-) -> Scenario:
-    """A scenario showing `case` (see the module docstring for the geometry).
+def _param(
+    default: float | None, low: float, high: float | None, unit: str, doc: str, **flags: bool
+) -> Any:
+    """A placement parameter: its default, its range (the one every entry point checks)."""
+    return field(default=default, metadata={"low": low, "high": high, "unit": unit, "doc": doc,
+                                            **flags})  # fmt: skip
 
-    `robot` gives the robot's size, camera and limits (its speed is replaced by
-    `robot_speed`); `looks` the mannequin (default adult).
+
+@dataclass(frozen=True)
+class CasePlacement:
+    """Where and how the pedestrian walks one of the nine cases (see the module docstring).
+
+    The one home of the placement's defaults and ranges: the record and closed-loop
+    commands, scenario files (`path.kind = "case"`) and the benchmarks fill it, and its
+    check names the parameter (PlacementError.field) so each can name its own key.
     """
-    case = Case(case)
-    for label, value in (("distance", distance), ("lateral_offset", lateral_offset)):
-        if not math.isfinite(value):
-            raise ValueError(f"{label} must be finite, got {value}")
-    if not (math.isfinite(robot_speed) and robot_speed >= 0):
-        raise ValueError(f"robot_speed must be >= 0 m/s, got {robot_speed}")
-    if case is Case.STILL:
-        pedestrian_speed = 0.0
-    elif not (math.isfinite(pedestrian_speed) and pedestrian_speed >= GROUND_DEAD_ZONE_MPS):
-        raise ValueError(
-            f"case {case.label!r} needs a walking speed of at least {GROUND_DEAD_ZONE_MPS} m/s "
-            f"(below that the ground truth is 'still'), got {pedestrian_speed}"
+
+    case: Case
+    distance: float = _param(
+        8.0, 0.0, 200.0, "m", "ahead of the robot's start where the path passes at meet_time"
+    )
+    lateral_offset: float = _param(0.0, -50.0, 50.0, "m", "to the left of that point")
+    pedestrian_speed: float = _param(
+        1.4, GROUND_DEAD_ZONE_MPS, 10.0, "m/s", "walking speed (case 9 stands)"
+    )
+    robot_speed: float = _param(2.0, 0.0, 40.0, "m/s", "the robot's speed")
+    angle_deg: float = _param(
+        45.0,
+        OBLIQUE_RANGE_DEG[0],
+        OBLIQUE_RANGE_DEG[1],
+        "degrees",
+        "oblique cases: off the robot's heading",
+        strict=True,
+    )
+    meet_time: float | None = _param(
+        None, 0.0, None, "s", "when the path passes the point (default: mid-run)"
+    )
+    facing_deg: float = _param(
+        180.0, -360.0, 360.0, "degrees", "case 9: which way the person faces (180: the camera)"
+    )
+    duration: float = _param(4.0, 0.0, 60.0, "s", "run length", open_low=True)
+    horizon: float = _param(1.0, 0.0, 10.0, "s", "warning horizon", open_low=True)
+    dt: float = _param(1.0 / 15.0, 1.0 / 60.0, 1.0, "s", "time per frame")
+    seed: int = _param(0, 0, 2**31 - 1, "", "world seed (gait phase)")
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "case", Case(self.case))
+        for f in fields(self):
+            if f.name == "case" or not f.metadata:
+                continue
+            if f.name == "pedestrian_speed" and self.case is Case.STILL:
+                continue  # a standing person has no walking speed
+            if f.name == "angle_deg" and not (self.case.lateral and self.case.depth):
+                continue  # only the obliques walk at an angle
+            value = getattr(self, f.name)
+            if value is None:
+                continue
+            problem = _out_of_range(
+                value, f.metadata, self.duration if f.name == "meet_time" else None
+            )
+            if problem:
+                raise PlacementError(f.name, value, problem)
+
+    @property
+    def walking_speed(self) -> float:
+        return 0.0 if self.case is Case.STILL else float(self.pedestrian_speed)
+
+    def scenario(
+        self,
+        looks: MannequinSpec | None = None,
+        robot: RobotSpec | None = None,
+        scene: SceneSpec | None = None,
+        name: str | None = None,
+    ) -> Scenario:
+        """The scenario: `robot` gives the robot's size, camera and limits (its speed is
+        replaced by robot_speed); `looks` the mannequin (default adult)."""
+        case, speed = self.case, self.walking_speed
+        meet = self.duration / 2 if self.meet_time is None else float(self.meet_time)
+        heading = case_heading_deg(case, self.angle_deg, self.facing_deg)
+        h = math.radians(heading)
+        pedestrian = PedestrianSpec(
+            x=self.distance - speed * meet * math.cos(h),
+            y=self.lateral_offset - speed * meet * math.sin(h),
+            heading_deg=heading,
+            speed=speed,
+            looks=looks or MannequinSpec.adult(),
         )
-    meet = duration / 2 if meet_time is None else float(meet_time)
-    if not (math.isfinite(meet) and meet >= 0):
-        raise ValueError(f"meet_time must be >= 0 s, got {meet_time}")
-    heading = case_heading_deg(case, angle_deg, facing_deg)
-    h = math.radians(heading)
-    x0 = distance - pedestrian_speed * meet * math.cos(h)
-    y0 = lateral_offset - pedestrian_speed * meet * math.sin(h)
-    pedestrian = PedestrianSpec(
-        x=x0,
-        y=y0,
-        heading_deg=heading,
-        speed=pedestrian_speed,
-        looks=looks or MannequinSpec.adult(),
-    )
-    return Scenario(
-        name=name or f"case{int(case)}-{case.label.replace(' ', '-')}",
-        pedestrian=pedestrian,
-        robot=replace(robot or RobotSpec(), speed=robot_speed),
-        scene=scene or SceneSpec(),
-        family="cases",
-        case=case,
-        duration=duration,
-        dt=dt,
-        horizon=horizon,
-        seed=seed,
-    )
+        return Scenario(
+            name=name or f"case{int(case)}-{case.label.replace(' ', '-')}",
+            pedestrian=pedestrian,
+            robot=replace(robot or RobotSpec(), speed=self.robot_speed),
+            scene=scene or SceneSpec(),
+            family="cases",
+            case=case,
+            duration=self.duration,
+            dt=self.dt,
+            horizon=self.horizon,
+            seed=self.seed,
+        )
+
+
+def _out_of_range(value: float, meta: Mapping[str, Any], high: float | None) -> str:
+    """Why `value` is outside the parameter's range ('' when inside)."""
+    low, high = meta["low"], meta["high"] if high is None else high
+    unit = f" {meta['unit']}" if meta["unit"] else ""
+    if not math.isfinite(value):
+        return "must be a finite number"
+    if meta.get("strict") and not low < value < high:
+        return f"must lie strictly between {low:.1f} and {high:.1f}{unit}"
+    if meta.get("open_low") and not value > low:
+        return f"must be > {low:g}{unit}"
+    if value < low:
+        return f"must be >= {low:g}{unit}"
+    if high is not None and value > high:
+        return f"must be <= {high:g}{unit}"
+    return ""
+
+
+PLACEMENT_FIELDS = {f.name: f for f in fields(CasePlacement) if f.name != "case"}
+
+
+def placement_help(name: str) -> str:
+    """A parameter's meaning, unit, range and default, for --help and the docs."""
+    meta, default = PLACEMENT_FIELDS[name].metadata, PLACEMENT_FIELDS[name].default
+    high = "" if meta["high"] is None else f"{meta['high']:g}"
+    unit = f" {meta['unit']}" if meta["unit"] else ""
+    shown = "mid-run" if default is None else f"{default:g}"
+    return f"{meta['doc']} ([{meta['low']:g}, {high}]{unit}; default {shown})"
 
 
 def default_crossing() -> Scenario:
     """An adult crossing from the left into the robot's path: contact at 2.7 s unless it brakes."""
-    return place_case(
-        Case.PERPENDICULAR_RIGHT,
-        distance=6.0,
-        robot_speed=2.0,
-        pedestrian_speed=1.4,
-        meet_time=3.0,
-        duration=5.0,
-        name="crossing-from-left",
+    placement = CasePlacement(
+        Case.PERPENDICULAR_RIGHT, distance=6.0, robot_speed=2.0, meet_time=3.0, duration=5.0
     )
+    return placement.scenario(name="crossing-from-left")

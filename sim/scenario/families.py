@@ -171,7 +171,7 @@ class PlacementError(ValueError):
     """A placement that cannot be built; `field` names the offending path key."""
 
     def __init__(self, field: str, value: object, reason: str) -> None:
-        super().__init__(reason)
+        super().__init__(f"{field} = {value!r}: {reason}")
         self.field = field
         self.value = value
         self.reason = reason

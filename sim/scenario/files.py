@@ -21,7 +21,7 @@ from typing import Any
 import numpy as np
 
 from monopic.cases import Case
-from sim.scenario.cases import place_case
+from sim.scenario.cases import PLACEMENT_FIELDS, CasePlacement
 from sim.scenario.families import (
     BODIES,
     CLOTHING,
@@ -208,8 +208,10 @@ class ScenarioFile:
     sweep: Sweep | None
     base: Scenario
 
-    def scenario(self, params: Mapping[str, Any], name: str, seed: int) -> Scenario:
-        """The scenario with `params` (dotted keys) set; errors name the file and field."""
+    def scenario(self, params: Mapping[str, Any], name: str, seed: int | None = None) -> Scenario:
+        """The scenario with `params` (dotted keys) set; errors name the file and field.
+
+        `seed` replaces the file's (or a swept) seed; None keeps it."""
         data = with_values(self.data, params)
         try:
             scenario = build(self.path, data)
@@ -220,7 +222,7 @@ class ScenarioFile:
             raise ScenarioFileError(
                 err.file, err.field, err.value, f"{err.reason} (with sweep values {shown})"
             ) from None
-        return replace(scenario, name=name, seed=seed)
+        return replace(scenario, name=name, seed=scenario.seed if seed is None else seed)
 
     def runs(self) -> Iterator[dict[str, Any]]:
         return expand(self.sweep, self.name)
@@ -470,33 +472,34 @@ def _path(
     return pedestrian, case, x_line
 
 
+# Where a CasePlacement parameter is set in a scenario file.
+PLACEMENT_KEYS = {"pedestrian_speed": "pedestrian.speed", "robot_speed": "robot.speed",
+                  "duration": "duration", "horizon": "horizon", "dt": "fps"}  # fmt: skip
+PATH_PLACEMENT = ("distance", "lateral_offset", "angle_deg", "meet_time", "facing_deg")
+
+
 def _case_path(
     t: TomlTable, robot: RobotSpec, speed: float, looks: Any, footprint: float, duration: float
 ) -> tuple[PedestrianSpec, Case]:
-    """sim.scenario.cases.place_case semantics: the path passes (distance, offset) at meet_time."""
-    number = t.integer("case", low=1, high=9)
-    case = Case(number)
-    kwargs = dict(
-        distance=t.number("distance", 8.0, low=0.0, high=200.0, unit="m"),
-        lateral_offset=t.number("lateral_offset", 0.0, low=-50.0, high=50.0, unit="m"),
-        angle_deg=t.number("angle_deg", 45.0, unit="degrees"),
-        meet_time=t.number("meet_time", duration / 2, low=0.0, high=duration, unit="s"),
-        facing_deg=t.number("facing_deg", 180.0, low=-360.0, high=360.0, unit="degrees"),
-    )
+    """sim.scenario.cases.CasePlacement: the path passes (distance, offset) at meet_time."""
+    case = Case(t.integer("case", low=1, high=9))
+    values: dict[str, Any] = {}
+    for name in PATH_PLACEMENT:
+        meta, default = PLACEMENT_FIELDS[name].metadata, PLACEMENT_FIELDS[name].default
+        if name == "angle_deg":  # its range holds for the obliques only: CasePlacement checks
+            values[name] = t.number(name, default, unit=meta["unit"])
+            continue
+        high = duration if name == "meet_time" else meta["high"]
+        default = duration / 2 if default is None else default
+        values[name] = t.number(name, default, low=meta["low"], high=high, unit=meta["unit"])
     try:
-        scenario = place_case(
-            case, pedestrian_speed=speed, robot_speed=robot.speed, duration=duration,
-            looks=looks, robot=robot, **kwargs,
-        )  # fmt: skip
-    except ValueError as err:
-        # place_case names its parameter in the message: map it back to the file's key.
-        message = str(err)
-        fields = {"walking speed": ("pedestrian.speed", speed)}
-        fields.update({key: (f"path.{key}", value) for key, value in kwargs.items()})
-        field, value = next(
-            (fv for word, fv in fields.items() if word in message), ("path", dict(kwargs))
+        placement = CasePlacement(
+            case, pedestrian_speed=speed, robot_speed=robot.speed, duration=duration, **values
         )
-        raise PlacementError(field, value, message) from None
+    except PlacementError as err:
+        key = PLACEMENT_KEYS.get(err.field, f"path.{err.field}")
+        raise PlacementError(key, err.value, err.reason) from None
+    scenario = placement.scenario(looks=looks, robot=robot)
     return replace(scenario.pedestrian, footprint=footprint), case
 
 

@@ -325,3 +325,9 @@ def footprints(truth: GroundTruth, pedestrian_size: float) -> tuple[np.ndarray, 
 def footprint_gap(truth: GroundTruth, pedestrian_size: float) -> float:
     """Metres between the robot's and the pedestrian's footprints (0 in contact)."""
     return polygon_gap(*footprints(truth, pedestrian_size))
+
+
+def pedestrian_passed(truth: GroundTruth, robot_length: float, footprint: float) -> bool:
+    """The pedestrian is behind the robot, clear of it: nothing more can happen in this run."""
+    clearance = robot_length / 2 + footprint
+    return bool(truth.position_robot[0] < -clearance)

@@ -22,7 +22,7 @@ import numpy as np
 
 from monopic.camera import CameraModel
 from sim.geometry.frames import Pose2D, yaw_quat
-from sim.scenario.spec import MannequinSpec, Occluder, RoadLayout
+from sim.scenario.spec import MannequinSpec, Scenario, SceneSpec
 from sim.world.body import PedestrianTruth, make_truth
 from sim.world.gait import Gait, MannequinPose
 from sim.world.mannequin import Mannequin, build_mannequin
@@ -46,14 +46,12 @@ class SceneConfig:
     """Everything static about a scene; poses change per frame through Scene's setters."""
 
     camera: CameraModel = field(default_factory=default_camera)
-    road: RoadLayout = field(default_factory=RoadLayout)
     pedestrian: MannequinSpec = field(default_factory=MannequinSpec)
-    occluders: tuple[Occluder, ...] = ()
-    sun_azimuth_deg: float = 210.0  # where the sunlight comes from, CCW from east
-    sun_elevation_deg: float = 50.0
-    # False: an overcast sky (diffuse light, no cast shadows); the shadow pass is half the
-    # render time on software GL (bench/simulator.py).
-    shadows: bool = True
+    # The scenario's street, parked cars, sun and sky (SceneSpec holds their defaults).
+    # Overcast (shadows False) also halves the render time on software GL: the shadow
+    # pass is half of it (bench/simulator.py).
+    spec: SceneSpec = field(default_factory=SceneSpec)
+    # How it is drawn: the same for every scenario.
     shadow_size: int = 768  # shadow map texels per side (1024: +4 ms a frame, same detections)
     shadow_half_extent: float = 20.0  # m, half-size of the sharp-shadow region
     shadow_centre_ahead: float = 12.0  # m ahead of the robot where that region is centred
@@ -64,6 +62,11 @@ class SceneConfig:
     sphere_slices: int = 12
     sphere_stacks: int = 8
     box_quads: int = 1
+
+    @classmethod
+    def of(cls, scenario: Scenario) -> SceneConfig:
+        """The scene a scenario describes, seen by its robot's camera."""
+        return cls(scenario.robot.camera.model(), scenario.pedestrian.looks, scenario.scene)
 
     def __post_init__(self) -> None:
         cam = self.camera
@@ -123,8 +126,8 @@ def build_spec(config: SceneConfig) -> mujoco.MjSpec:
     vis.map.zfar = FAR_CLIP / SCENE_EXTENT
     vis.map.shadowclip = config.shadow_half_extent / SCENE_EXTENT
     # Overcast: more sky light from everywhere, a weak sun that casts nothing.
-    vis.headlight.ambient = [0.32, 0.32, 0.33] if config.shadows else [0.5, 0.5, 0.52]
-    vis.headlight.diffuse = [0.25, 0.25, 0.25] if config.shadows else [0.3, 0.3, 0.3]
+    vis.headlight.ambient = [0.32, 0.32, 0.33] if config.spec.shadows else [0.5, 0.5, 0.52]
+    vis.headlight.diffuse = [0.25, 0.25, 0.25] if config.spec.shadows else [0.3, 0.3, 0.3]
     vis.headlight.specular = [0.0, 0.0, 0.0]
 
     spec.add_texture(
@@ -137,19 +140,19 @@ def build_spec(config: SceneConfig) -> mujoco.MjSpec:
         height=3072,
     )
 
-    build_street(spec, config.road, config.occluders)
+    build_street(spec, config.spec.road, config.spec.occluders)
 
     # Sun: a directional light hung from a mocap anchor that the scene keeps ahead of
     # the robot; the anchor never rotates, so the light direction stays fixed in the world.
     anchor = spec.worldbody.add_body(name="sun_anchor", mocap=True)
-    direction = sun_direction(config.sun_azimuth_deg, config.sun_elevation_deg)
+    direction = sun_direction(config.spec.sun_azimuth_deg, config.spec.sun_elevation_deg)
     anchor.add_light(
         name="sun",
         type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
         pos=(-60.0 * direction).tolist(),
         dir=direction.tolist(),
-        castshadow=config.shadows,
-        diffuse=[0.78, 0.76, 0.72] if config.shadows else [0.35, 0.35, 0.36],
+        castshadow=config.spec.shadows,
+        diffuse=[0.78, 0.76, 0.72] if config.spec.shadows else [0.35, 0.35, 0.36],
         ambient=[0.12, 0.12, 0.13],
         specular=[0.15, 0.15, 0.15],
     )

@@ -82,19 +82,8 @@ class World(Closing):
         self.render_frames = render
         self.render_context = render_context
         self.ttc_lookahead = ttc_lookahead
-        self.camera: CameraModel = scenario.robot.camera.model()
-        scene_spec = scenario.scene
-        self.scene = Scene(
-            SceneConfig(
-                camera=self.camera,
-                road=scene_spec.road,
-                pedestrian=scenario.pedestrian.looks,
-                occluders=scene_spec.occluders,
-                sun_azimuth_deg=scene_spec.sun_azimuth_deg,
-                sun_elevation_deg=scene_spec.sun_elevation_deg,
-                shadows=scene_spec.shadows,
-            )
-        )
+        self.scene = Scene(SceneConfig.of(scenario))
+        self.camera: CameraModel = self.scene.camera
         self._renderer: SceneRenderer | None = None
         self.road: Road | None = None
         self.robot: Robot | None = None

@@ -16,7 +16,7 @@ from sim.runs.closed_loop import (
     run_closed_loop,
     summarise,
 )
-from sim.scenario.cases import place_case
+from sim.scenario.cases import CasePlacement
 from sim.scenario.spec import CameraSpec, RobotSpec
 
 DT = 1.0 / 15.0
@@ -27,14 +27,10 @@ def crossing(case: Case, speed: float = 2.0, meet: float = 2.0):
 
     Half-size frames (384x216) keep the test quick; the pose is still found at these ranges.
     """
-    return place_case(
-        case,
-        distance=speed * meet,
-        robot_speed=speed,
-        robot=RobotSpec(camera=CameraSpec(width=384, height=216)),
-        meet_time=meet,
-        duration=meet + 0.6,
-        name=f"case{int(case)}@{speed:g}",
+    return CasePlacement(
+        case, distance=speed * meet, robot_speed=speed, meet_time=meet, duration=meet + 0.6
+    ).scenario(
+        robot=RobotSpec(camera=CameraSpec(width=384, height=216)), name=f"case{int(case)}@{speed:g}"
     )
 
 

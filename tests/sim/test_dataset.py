@@ -23,23 +23,24 @@ from sim.dataset.coco import (
     read_coco,
     rle_counts,
 )
-from sim.dataset.spec import GRID_KEYS, expand, load_spec
+from sim.dataset.spec import expand, load_spec
+from tests.paths import SCENARIOS
 
-TINY = """\
+CASE_GRID = SCENARIOS / "datasets" / "case_grid.toml"
+TINY = f"""\
 name = "tiny"
 description = "two short runs for the tests"
-seed = 7
-duration = 0.5
-fps = 15
-[camera]
-width = 384
-height = 216
-[grid]
-cases = [5, 6]
-distances = [4.5]
-robot_speeds = [1.0]
+[[include]]
+files = ["{CASE_GRID}"]
+sampling = "grid"
+[include.parameters]
+"path.case" = [5, 6]
+"path.distance" = [4.5]
+"robot.speed" = [1.0]
+duration = [0.5]
+"robot.camera.width" = [384]
+"robot.camera.height" = [216]
 """
-KNOWN_GRID_KEYS = ", ".join(sorted(GRID_KEYS))  # the form detection takes these for a grid's
 TIMING_COLUMNS = ("detectMs", "landmarksMs", "featuresMs", "predictMs", "warningMs", "totalMs")
 
 
@@ -61,37 +62,37 @@ def dataset(tmp_path_factory) -> tuple[Path, Path, dict]:
 # -- the spec ------------------------------------------------------------------------
 
 
-@pytest.mark.parametrize(
-    ("change", "expected"),
-    [
-        (("cases = [5, 6]", "cases = [5, 10]"), "grid.cases[1] = 10: must be <= 9"),
-        (("cases = [5, 6]", 'cases = "5"'), "grid.cases = '5': must be a non-empty list"),
-        (
-            ("fps = 15", "fps = 15\ncolour = 3"),
-            f"colour = 3: unknown key (known here: {KNOWN_GRID_KEYS};",
-        ),
-        (("robot_speeds = [1.0]", "robot_speeds = [1.0, 1.0]"), "lists a value twice"),
-        (("[camera]", "[camera]\nwidth_px = 3"), "camera.width_px = 3: unknown key"),
-        (('name = "tiny"', 'name = "a b"'), "name = 'a b': must be a non-empty name"),
-        (("seed = 7", "seed = -1"), "seed = -1: must be an integer in [0, 2147483647]"),
-    ],
-)
-def test_spec_errors_name_file_field_and_value(tmp_path, change, expected):
-    path = write_spec(tmp_path, TINY.replace(*change))
+def test_the_old_grid_form_is_refused_with_the_way_to_write_it(tmp_path):
+    path = write_spec(tmp_path, 'name = "old"\n[grid]\ncases = [5]\ndistances = [4.0]\n')
     with pytest.raises(UserError) as err:
         load_spec(path)
     message = str(err.value)
-    assert message.startswith(str(path)) and expected in message and "\n" not in message
+    assert message.startswith(f"{path}: grid = ") and "path.case" in message
+    assert "case_grid.toml" in message and "\n" not in message
 
 
-def test_grid_expands_in_a_fixed_order_with_distinct_seeds(tmp_path):
-    spec = load_spec(write_spec(tmp_path, TINY.replace("cases = [5, 6]", "cases = [5, 6, 9]")))
+def test_a_case_grid_expands_in_a_fixed_order_with_distinct_seeds_and_no_repeats(tmp_path):
+    text = TINY.replace('"path.case" = [5, 6]', '"path.case" = [5, 6, 9]')
+    text = text.replace(
+        '"robot.speed" = [1.0]', '"robot.speed" = [1.0]\n"pedestrian.speed" = [1.0, 1.4]'
+    )
+    spec = load_spec(write_spec(tmp_path, text))
     runs = expand(spec)
-    assert [r.id for r in runs] == ["r0000", "r0001", "r0002"]
-    assert [r.params["case"] for r in runs] == [5, 6, 9]
-    assert len({r.scenario.seed for r in runs}) == 3
+    # Two walking speeds for two walking cases, one run of the standing person (case 9).
+    assert [r.scenario.case for r in runs] == [5, 5, 6, 6, 9]
+    assert [r.id for r in expand(spec)] == [r.id for r in runs]
+    assert all(r.id.startswith("case-grid/") for r in runs)
+    assert len({r.scenario.seed for r in runs}) == 5
     assert [r.scenario.seed for r in expand(spec)] == [r.scenario.seed for r in runs]
-    assert runs[2].params["pedestrian_speed"] == 0.0  # standing still
+    assert runs[-1].scenario.pedestrian.speed == 0.0  # standing still
+
+
+def test_the_shipped_case_grids_hold_every_case(tmp_path):
+    for name, runs in (("cases-train", 68), ("cases-heldout", 18)):
+        spec = load_spec(SCENARIOS / "datasets" / f"{name}.toml")
+        expanded = expand(spec)
+        assert len(expanded) == runs
+        assert {r.scenario.case for r in expanded} == set(range(1, 10))
 
 
 def test_rle_round_trip():
@@ -135,7 +136,7 @@ def test_coco_files_keypoints_and_masks(dataset):
         seen = k33[k33[:, 2] == 2]
         assert np.all((seen[:, 0] >= 0) & (seen[:, 0] < 384) & (seen[:, 1] < 216))
     # A person fully in view gets an annotation on every frame.
-    truth = [json.loads(line) for p in sorted((out / "truth").glob("*.jsonl"))
+    truth = [json.loads(line) for p in sorted((out / "truth").rglob("*.jsonl"))
              for line in p.read_text().splitlines()]  # fmt: skip
     in_view = {t["image"] for t in truth if t["in_frame"] and t["visible_fraction"] == 1.0}
     annotated = {b33.images[a["image_id"]]["file_name"] for a in b33.annotations}
@@ -172,8 +173,8 @@ def test_truth_rows_and_features_in_the_authors_format(dataset):
     assert len(rows) == counts["images"]
     assert {r["case"] for r in rows} == {"5", "6"}  # perpendicular right, left
     runs = list(csv.DictReader((out / "runs.csv").open()))
-    assert [r["run"] for r in runs] == ["r0000", "r0001"]
-    for path in sorted((out / "features").glob("*.csv")):
+    assert [r["run"] for r in runs] == [r.id for r in expand(load_spec(dataset[0]))]
+    for path in sorted((out / "features").rglob("*.csv")):
         log = read_log(path)  # the authors' log reader accepts it
         assert len(log) >= 5
     card = (out / "README.md").read_text()
@@ -219,15 +220,17 @@ def test_deterministic_and_resumable(dataset, tmp_path):
     # Resume: a run whose record is gone is rendered again, the finished one is skipped.
     again = tmp_path / "again"
     shutil.copytree(out, again)
-    (again / "runs" / "r0001.json").unlink()
-    (again / "images" / "r0001" / "0003.jpg").unlink()
+    second = expand(spec)[1].id
+    (again / "runs" / f"{second}.json").unlink()
+    (again / "images" / second / "0003.jpg").unlink()
     messages: list[str] = []
     build(spec, again, report=messages.append)
     assert any("1 of 2 runs already finished, 1 to render" in m for m in messages)
     assert comparable(again) == comparable(out)
-    for path in sorted((out / "features").glob("*.csv")):
-        assert _without_timing(path) == _without_timing(again / "features" / path.name)
+    for path in sorted((out / "features").rglob("*.csv")):
+        relative = path.relative_to(out / "features")
+        assert _without_timing(path) == _without_timing(again / "features" / relative)
     # Another spec may not write into the same folder.
-    other = load_spec(write_spec(tmp_path, TINY.replace("seed = 7", "seed = 8")))
+    other = load_spec(write_spec(tmp_path, TINY.replace("[4.5]", "[4.6]")))
     with pytest.raises(UserError, match="made from another spec"):
         build(other, again, report=lambda _: None)

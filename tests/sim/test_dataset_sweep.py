@@ -92,14 +92,14 @@ def test_monopic_sweep_accepts_the_dataset_keys_of_a_sweep_spec(
         (('licence = "CC0-1.0"', "licence = 3"), "licence = 3: must be a string, not an integer"),
         (('licence = "CC0-1.0"', 'licence = " "'), "licence = ' ': must not be empty"),
         (('name = "tiny-sweep"', 'name = "a b"'), "name = 'a b': must be a non-empty name"),
-        # A case grid's keys are not a sweep spec's: the seeds come from the includes.
+        # The seeds come from the includes, not from the top of the spec.
         (("licence", "seed = 3\nlicence"), f"seed = 3: unknown key (known here: {SWEEP_KEYS}; see"),
         (("runs = 1", "runs = 0"), "include[0].runs = 0: must be an integer >= 1"),
         (("sampling = \"random\"", "sampling = \"all\""), "include[0].sampling = 'all': must be"),
         (("case6_*", "case66_*"), "include[0].files = '/"),
         (("duration = [0.5]", "duration = [-1.0]"), "duration = -1.0: must be > 0 s"),
         (("[[include]]", "[grid]\ncases = [5]\n[[include]]"),
-         "grid = {cases = [5]}: a dataset spec has either [grid] (a case grid) or [[include]]"),
+         "grid = {cases = [5]}: the [grid] form is gone: a dataset spec is a sweep spec"),
         (("include", "includes"), "includes = [{files = ['/"),
     ],
 )  # fmt: skip
@@ -114,7 +114,7 @@ def test_a_bad_sweep_form_spec_is_one_line_naming_file_field_and_value(
     assert message.startswith(str(path)) or message.startswith(str(CASES)), message
 
 
-def test_neither_form_is_a_one_line_error_through_the_command(
+def test_a_spec_without_includes_is_a_one_line_error_through_the_command(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
     typo = write_spec(tmp_path, TINY_SWEEP.replace("include", "includes"), "typo.toml")
@@ -122,14 +122,11 @@ def test_neither_form_is_a_one_line_error_through_the_command(
     out = str(tmp_path / "out")
     assert main(["dataset", str(typo), "--out", out]) == 2
     err = capsys.readouterr().err.strip()
-    assert f"{typo}: includes = [" in err and "unknown key, and a dataset spec needs" in err
+    assert f"{typo}: includes = [" in err and "unknown key (known here: " in err
     assert "\n" not in err
     assert main(["dataset", str(empty), "--out", out]) == 2
     err = capsys.readouterr().err.strip()
-    assert err.endswith(
-        f"{empty}: grid: missing, and so is include: a dataset spec needs [grid] (a case "
-        "grid) or [[include]] (a sweep spec); see scenarios/datasets/README.md"
-    )
+    assert err.endswith(f"{empty}: include = []: a sweep needs at least one [[include]]")
     assert not (tmp_path / "out").exists()
 
 

@@ -12,7 +12,7 @@ from gymnasium.utils.env_checker import check_env
 from monopic.cases import Case
 from sim.envs import ENV_ID
 from sim.envs.crossing import PedestrianCrossingEnv
-from sim.scenario.cases import default_crossing, place_case
+from sim.scenario.cases import CasePlacement, default_crossing
 from sim.scenario.spec import CameraSpec, RoadLayout, Scenario
 
 SMALL = CameraSpec(width=160, height=90)
@@ -116,7 +116,9 @@ def test_contact_terminates_with_a_penalty_and_braking_avoids_it() -> None:
 
 
 def test_passing_the_pedestrian_terminates() -> None:
-    sc = small(place_case(Case.AWAY, distance=3.0, lateral_offset=3.0, robot_speed=4.0))
+    sc = small(
+        CasePlacement(Case.AWAY, distance=3.0, lateral_offset=3.0, robot_speed=4.0).scenario()
+    )
     env = make(scenario=sc)
     try:
         env.reset(seed=0)
@@ -148,7 +150,9 @@ def test_top_down_view_is_drawn_under_the_dummy_video_driver(
     """highway-env draws nothing under SDL_VIDEODRIVER=dummy; our viewer must still draw,
     with north up: a pedestrian on the robot's left (north) is above it in the view."""
     monkeypatch.setenv("SDL_VIDEODRIVER", "dummy")
-    sc = small(place_case(Case.STILL, distance=6.0, lateral_offset=3.0, robot_speed=0.0))
+    sc = small(
+        CasePlacement(Case.STILL, distance=6.0, lateral_offset=3.0, robot_speed=0.0).scenario()
+    )
     env = make("top_down", scenario=sc)
     try:
         env.reset(seed=0)

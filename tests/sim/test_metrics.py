@@ -19,6 +19,7 @@ from sim.analysis.metrics import (
     wilson,
 )
 from sim.analysis.report import write_report
+from sim.runs.result import RunResult
 
 DT = 0.1
 KEY = "rules/image"
@@ -37,8 +38,8 @@ def row(
     pred_case: list[int | None] | None = None,
     pose_ms: float = 10.0,
     robot_speed: float = 2.0,
-) -> dict[str, Any]:
-    """A result line in the runner's schema with only what the metrics read."""
+) -> RunResult:
+    """A result record with hand-made columns (what the metrics read; the rest plain)."""
     n = len(ttc)
     t = [round(k * DT, 4) for k in range(n)]
     foot = [[100.0 + 10 * k, 200.0] for k in range(n)]
@@ -54,60 +55,75 @@ def row(
             "ttc": [None] * n,
         }
     }
-    return {
-        "schema": 1,
-        "id": run_id,
-        "family": family,
-        "kind": kind,
-        "scale": scale,
-        "seed": 1,
-        "params": {},
-        "scenario": {
-            "case": None,
-            "robot_speed": robot_speed,
-            "horizon": horizon,
-            "dt": DT,
-            "camera": {"width": 320, "height": 180},
-        },
-        "truth": {
-            "t": t,
-            "ttc": ttc,
-            "collision": [int(c is not None and c <= horizon) for c in ttc],
-            "case": case or [5] * n,
-            "phi": [0.0] * n,
-            "range": [5.0] * n,
-            "height": [100.0] * n,
-            "in_frame": [1] * n,
-            "visible": [1.0] * n,
-            "foot": foot,
-            "future": [[1.0, 0.0]] * n,
-        },
-        "pipelines": {
-            "main": {"found": [1] * n, "phi": [10.0] * n, "decisions": decisions},
-        },
-        "timing": {
-            "ms": {
-                "main": {
-                    "pose": [pose_ms] * n,
-                    "features": [0.0] * n,
-                    "predict": [0.0] * n,
-                    "warning": [0.0] * n,
-                    "total": [pose_ms] * n,
-                }
+    return RunResult.from_json(
+        {
+            "schema": 1,
+            "id": run_id,
+            "family": family,
+            "kind": kind,
+            "scale": scale,
+            "seed": 1,
+            "params": {},
+            "scenario": {
+                "name": run_id,
+                "case": None,
+                "robot_speed": robot_speed,
+                "robot_width": 0.6,
+                "robot_length": 0.8,
+                "horizon": horizon,
+                "dt": DT,
+                "duration": n * DT,
+                "camera": {
+                    "width": 320,
+                    "height": 180,
+                    "vertical_fov_deg": 65.0,
+                    "mount_height": 1.2,
+                    "pitch_deg": 5.0,
+                },
+                "pedestrian_height": 1.8,
+                "pedestrian_speed": 1.4,
+                "occluders": 0,
             },
-            "machine": {"cpu": "test", "cores": 1},
-        },
-    }
+            "truth": {
+                "t": t,
+                "ttc": ttc,
+                "collision": [int(c is not None and c <= horizon) for c in ttc],
+                "case": case or [5] * n,
+                "phi": [0.0] * n,
+                "range": [5.0] * n,
+                "height": [100.0] * n,
+                "in_frame": [1] * n,
+                "visible": [1.0] * n,
+                "foot": foot,
+                "future": [[1.0, 0.0]] * n,
+            },
+            "pipelines": {
+                "main": {"found": [1] * n, "phi": [10.0] * n, "decisions": decisions},
+            },
+            "timing": {
+                "ms": {
+                    "main": {
+                        "pose": [pose_ms] * n,
+                        "features": [0.0] * n,
+                        "predict": [0.0] * n,
+                        "warning": [0.0] * n,
+                        "total": [pose_ms] * n,
+                    }
+                },
+                "machine": {"cpu": "test", "cores": 1},
+            },
+        }
+    )
 
 
-def collision_row(run_id: str, first_warning: int | None, **kw: Any) -> dict[str, Any]:
+def collision_row(run_id: str, first_warning: int | None, **kw: Any) -> RunResult:
     """20 frames, contact at t = 2.0 s; warnings from frame `first_warning` on."""
     ttc = [round(2.0 - k * DT, 4) for k in range(20)]
     warn = [int(first_warning is not None and k >= first_warning) for k in range(20)]
     return row(run_id, ttc, warn, **kw)
 
 
-def near_miss_row(run_id: str, warn_frames: set[int]) -> dict[str, Any]:
+def near_miss_row(run_id: str, warn_frames: set[int]) -> RunResult:
     return row(run_id, [None] * 20, [int(k in warn_frames) for k in range(20)], kind="near-miss")
 
 

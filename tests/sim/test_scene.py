@@ -12,7 +12,7 @@ import sim.world.render
 from monopic.camera import CameraModel
 from sim.dataset.clip import ClipSpec, clip_scene, truth_header, truth_row, walk
 from sim.geometry.frames import Pose2D
-from sim.scenario.spec import MannequinSpec, Occluder, RoadLayout
+from sim.scenario.spec import MannequinSpec, Occluder, RoadLayout, SceneSpec
 from sim.world.gait import JOINT_FIELDS, Gait, idle_pose, pose_vector
 from sim.world.mannequin import geom_z_extent
 from sim.world.render import GLUnavailableError, Marker, SceneRenderer
@@ -26,7 +26,8 @@ ROBOT = Pose2D(3.0, -2.0, 0.7)
 
 def small_scene(camera: CameraModel = SMALL, **kw: object) -> Scene:
     """A light scene (no buildings) with the pedestrian placed behind the camera."""
-    config = SceneConfig(camera=camera, road=RoadLayout(buildings=False), **kw)  # type: ignore[arg-type]
+    spec = SceneSpec(road=RoadLayout(buildings=False), **kw)  # type: ignore[arg-type]
+    config = SceneConfig(camera=camera, spec=spec)
     scene = Scene(config)
     scene.set_camera_pose(ROBOT.x, ROBOT.y, ROBOT.yaw)
     behind = ROBOT.to_world(np.array([-10.0, 0.0, 0.0]))
@@ -95,7 +96,7 @@ def test_person_facing_the_camera_shows_their_left_on_the_image_right() -> None:
     "look, height", [(MannequinSpec.adult(), 1.8), (MannequinSpec.child(), 1.15)]
 )
 def test_mannequin_height_and_feet_on_the_ground(look: MannequinSpec, height: float) -> None:
-    scene = Scene(SceneConfig(pedestrian=look, road=RoadLayout(buildings=False)))
+    scene = Scene(SceneConfig(pedestrian=look, spec=SceneSpec(road=RoadLayout(buildings=False))))
     scene.set_pedestrian(1.0, 2.0, 0.3)  # idle stance
     truth = scene.truth()
     assert truth.top_z == pytest.approx(height, abs=0.01)
@@ -146,7 +147,7 @@ def knee_angles(scene: Scene) -> np.ndarray:
 
 
 def test_knees_bend_when_walking_and_not_when_standing() -> None:
-    scene = Scene(SceneConfig(road=RoadLayout(buildings=False)))
+    scene = Scene(SceneConfig(spec=SceneSpec(road=RoadLayout(buildings=False))))
     flex = []
     for phase in np.linspace(0, 1, 20, endpoint=False):
         scene.set_pedestrian(0.0, 0.0, 0.0, gait_phase=phase, speed=1.4)

@@ -19,7 +19,7 @@ from monopic.recording import RunRecording, predictor_colour
 from sim.geometry.polygons import polygon_gap, rectangle
 from sim.recording.sim_recording import PREDICTOR_STATES, world_eye
 from sim.runs.record import record_run
-from sim.scenario.cases import place_case
+from sim.scenario.cases import CasePlacement
 from sim.world.ground_truth import footprint_gap
 from sim.world.world import World
 from tests.rrd import column
@@ -94,9 +94,9 @@ def test_polygon_gap():
 @pytest.mark.slow
 def test_recording_holds_camera_truth_world_and_series(tmp_path):
     # On a collision course: the robot at 2 m/s meets the crossing pedestrian at 1 s.
-    scenario = place_case(
+    scenario = CasePlacement(
         Case.PERPENDICULAR_RIGHT, distance=2.0, robot_speed=2.0, meet_time=1.0, duration=1.4
-    )
+    ).scenario()
     rrd = tmp_path / "run.rrd"
     summary = record_run(scenario, rrd, topdown_every=3)
     assert rrd.exists() and summary.bytes == rrd.stat().st_size

@@ -17,8 +17,8 @@ from monopic.cli.main import main
 from monopic.errors import UserError
 from sim.runs.code_version import code_version
 from sim.runs.executors import local_executor, ray_executor, ray_runtime_env, work
-from sim.runs.results_file import ResultsWriter, read_rows, scan
-from sim.runs.runner import deterministic_part
+from sim.runs.result import RunResult
+from sim.runs.results_file import ResultsWriter, read_results, read_rows, scan
 from sim.runs.sweep import expand_spec, load_spec, run_sweep
 from sim.world.render import KeptRenderContext
 from tests.rrd import rows_per_entity
@@ -65,10 +65,14 @@ def spec_path(tmp_path: Path) -> Path:
     return path
 
 
+def deterministic(row: dict) -> dict:
+    return RunResult.from_json(row).deterministic()
+
+
 def by_id(path: Path) -> dict[str, dict]:
-    rows = list(read_rows(path))
-    assert len({r["id"] for r in rows}) == len(rows), "duplicate run ids"
-    return {r["id"]: deterministic_part(r) for r in rows}
+    rows = list(read_results(path))
+    assert len({r.id for r in rows}) == len(rows), "duplicate run ids"
+    return {r.id: r.deterministic() for r in rows}
 
 
 def test_results_file_ignores_a_torn_tail_and_rejects_a_bad_middle(tmp_path: Path) -> None:
@@ -104,7 +108,7 @@ def test_a_worker_keeps_one_render_context_for_its_runs(spec_path: Path) -> None
     assert not any("error" in r for r in rows)
     # The same results as runs with their own context.
     fresh = [work(spec) for spec in specs[:2]]
-    assert [deterministic_part(r) for r in rows] == [deterministic_part(r) for r in fresh]
+    assert [deterministic(r) for r in rows] == [deterministic(r) for r in fresh]
 
 
 @pytest.mark.slow
@@ -136,17 +140,17 @@ def test_sweep_writes_one_line_per_run_and_resumes_without_loss(
     assert (third.finished, third.skipped) == (1, 2)
     again = by_id(out)
     assert sorted(again) == sorted(ids)
-    assert again[last["id"]] == deterministic_part(last)  # deterministic per run
+    assert again[last["id"]] == deterministic(last)  # deterministic per run
 
     # Every line holds both pipelines side by side with the truth, frame for frame, and
     # says which code made it.
-    row = next(iter(read_rows(out)))
-    assert row["code"] == code_version()
-    assert set(row["pipelines"]) == {"main", "gtcrop"}
-    n = row["frames"]
-    assert len(row["truth"]["t"]) == n
-    for cols in row["pipelines"]["main"]["decisions"].values():
-        assert all(len(v) == n for v in cols.values())
+    record = next(iter(read_results(out)))
+    assert record.code == code_version()
+    assert set(record.pipelines) == {"main", "gtcrop"}
+    n = record.frames
+    assert len(record.truth.t) == n
+    for cols in record.pipelines["main"].decisions.values():
+        assert all(len(v) == n for v in vars(cols).values())
 
     # Runs that went wrong (missed collision, false alarm) keep a recording, the others not.
     recorded = sorted(r["recording"] for r in read_rows(out) if r["recording"])

@@ -18,7 +18,7 @@ from monopic.cases import Case
 from monopic.features.orientation import facing_angle
 from sim.geometry.frames import Pose2D, wrap_angle
 from sim.geometry.highway_frame import highway_to_world, reflect, world_to_highway
-from sim.scenario.cases import case_heading_deg, default_crossing, place_case
+from sim.scenario.cases import CasePlacement, case_heading_deg, default_crossing
 from sim.scenario.path import PedestrianPath
 from sim.scenario.spec import (
     CameraSpec,
@@ -146,8 +146,8 @@ def test_marker_lands_on_the_camera_model_projection_with_a_moving_robot() -> No
 def test_a_borrowed_render_context_renders_as_a_fresh_one_and_outlives_its_worlds() -> None:
     """Worlds one after another on one RenderContext (as a sweep worker runs them) draw the
     same images as worlds with their own, and leave the context open for the next."""
-    first = place_case(Case.PERPENDICULAR_RIGHT, distance=8.0)
-    second = place_case(Case.OBLIQUE_LEFT_AWAY, distance=6.0)
+    first = CasePlacement(Case.PERPENDICULAR_RIGHT, distance=8.0).scenario()
+    second = CasePlacement(Case.OBLIQUE_LEFT_AWAY, distance=6.0).scenario()
 
     def frames(sc: Scenario, context: RenderContext | None) -> list[np.ndarray]:
         with World(sc, render_context=context) as world:
@@ -262,7 +262,9 @@ def test_side_by_side_near_miss_and_graze(offset: float, meets: bool) -> None:
 def test_crossing_ahead_in_time_is_a_near_miss() -> None:
     """The pedestrian crosses 6 m ahead at t = 1.5 s; the robot's front is at 4.2 m at most
     while the pedestrian is within its width: no contact, no collision, no TTC."""
-    sc = place_case(Case.PERPENDICULAR_RIGHT, distance=6.0, robot_speed=2.0, meet_time=1.5)
+    sc = CasePlacement(
+        Case.PERPENDICULAR_RIGHT, distance=6.0, robot_speed=2.0, meet_time=1.5
+    ).scenario()
     truths = run_truth(replace(sc, scene=LIGHT_SCENE, duration=4.0))
     assert all(t.time_to_collision is None and not t.collision for t in truths)
 
@@ -337,7 +339,7 @@ PLACEMENTS = [
 @pytest.mark.parametrize("params", PLACEMENTS, ids=lambda p: ",".join(p) or "defaults")
 @pytest.mark.parametrize("case", list(Case), ids=lambda c: c.name.lower())
 def test_every_placed_case_is_labelled_as_that_case(case: Case, params: dict) -> None:
-    sc = replace(place_case(case, **params), scene=LIGHT_SCENE)
+    sc = replace(CasePlacement(case, **params).scenario(), scene=LIGHT_SCENE)
     truths = run_truth(sc)
     assert len(truths) == sc.frames
     assert {t.case for t in truths} == {case}
@@ -351,16 +353,16 @@ def test_every_placed_case_is_labelled_as_that_case(case: Case, params: dict) ->
 
 def test_oblique_angles_outside_their_sector_are_refused() -> None:
     with pytest.raises(ValueError, match="angle_deg"):
-        place_case(Case.OBLIQUE_LEFT_AWAY, angle_deg=15.0)
-    with pytest.raises(ValueError, match="walking speed"):
-        place_case(Case.TOWARD, pedestrian_speed=0.1)
+        CasePlacement(Case.OBLIQUE_LEFT_AWAY, angle_deg=15.0).scenario()
+    with pytest.raises(ValueError, match=r"pedestrian_speed = 0.1: must be >= 0.3 m/s"):
+        CasePlacement(Case.TOWARD, pedestrian_speed=0.1).scenario()
     assert case_heading_deg(Case.OBLIQUE_RIGHT_TOWARD, 40.0) == pytest.approx(-140.0)
 
 
 @pytest.mark.parametrize("facing_deg", [180.0, 150.0, 100.0, 60.0, 0.0, -45.0, -120.0])
 def test_true_phi_matches_the_pipeline_formula_on_true_shoulders(facing_deg: float) -> None:
     """The phi in the truth equals what monopic's orientation gives for the true shoulders."""
-    sc = place_case(Case.STILL, distance=5.0, robot_speed=0.0, facing_deg=facing_deg)
+    sc = CasePlacement(Case.STILL, distance=5.0, robot_speed=0.0, facing_deg=facing_deg).scenario()
     with World(replace(sc, scene=LIGHT_SCENE), render=False) as world:
         truth = world.reset().truth
         camera = world.camera
@@ -388,7 +390,9 @@ def test_a_parked_car_occludes_a_child_behind_it() -> None:
 
 
 def test_same_seed_same_frames_and_truth() -> None:
-    sc = replace(place_case(Case.OBLIQUE_LEFT_TOWARD, distance=6.0), scene=LIGHT_SCENE)
+    sc = replace(
+        CasePlacement(Case.OBLIQUE_LEFT_TOWARD, distance=6.0).scenario(), scene=LIGHT_SCENE
+    )
     sc = replace(sc, robot=replace(sc.robot, camera=CameraSpec(width=160, height=90)))
 
     def frames(seed: int) -> list:
@@ -428,3 +432,19 @@ def test_the_renderer_is_made_lazily_and_a_spawned_worker_renders_its_own_world(
     with multiprocessing.get_context("spawn").Pool(1) as pool:
         shape, std, pid = pool.apply(_first_frame_in_worker, (sc,))
     assert shape == (90, 160, 3) and std > 10 and pid != os.getpid()
+
+
+def test_the_case_placement_checks_the_same_range_at_every_entry_point(tmp_path, capsys) -> None:
+    from monopic.cli.main import main
+
+    with pytest.raises(ValueError, match=r"distance = -3.0: must be >= 0 m"):
+        CasePlacement(Case.PERPENDICULAR_LEFT, distance=-3.0)
+    assert main(["record", "5", "--distance", "-3", "--rrd", str(tmp_path / "x.rrd")]) == 2
+    assert "--distance -3: must be >= 0 m" in capsys.readouterr().err
+    scenario = tmp_path / "case.toml"
+    scenario.write_text('name = "c"\n[path]\nkind = "case"\ncase = 5\ndistance = -3.0\n')
+    from sim.scenario.files import ScenarioFileError, load
+
+    with pytest.raises(ScenarioFileError, match=r"case.toml: path.distance = -3.0: must be >= 0"):
+        load(scenario)
+    assert not (tmp_path / "x.rrd").exists()

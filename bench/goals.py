@@ -1,0 +1,130 @@
+"""The goals BENCHMARKS.md opens with, each read from the latest run of one benchmark.
+
+Issue 7's goals: the whole pipeline at most half the reference's per-frame time at the
+same thread count (1 and 2), landmark error equal or better (judged by the paired 95 %
+interval of bench/paired.py), and a scenario run on one core at least as fast as real
+time at 15 fps. A goal reads the structured results of bench/history.jsonl, never the
+Markdown, so the goal table cannot drift from the figures below it. A later goal is one
+more entry in GOALS.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+RATIO_GOAL = 0.5  # ours / reference, whole-frame p50 on frames both sides found
+REALTIME_FPS = 15.0  # the camera's frame rate a scenario run must keep up with on one core
+
+
+@dataclass(frozen=True)
+class Standing:
+    """Where one goal stands in one run: the figure in words and whether it meets the goal."""
+
+    measured: str
+    met: bool
+
+
+@dataclass(frozen=True)
+class Goal:
+    """A goal, the benchmark whose latest run measures it, and how to read that run."""
+
+    text: str
+    benchmark: str
+    read: Callable[[dict[str, Any]], Standing | None]  # None: the run lacks the figure
+
+
+def _latency(results: dict[str, Any], threads: int, side: str) -> dict[str, Any] | None:
+    for row in results.get("latency", []):
+        if (row["threads"], row["frames"], row["stage"], row["side"]) == (
+            threads,
+            "both found",
+            "whole frame",
+            side,
+        ):
+            return row
+    return None
+
+
+def ratio_at(threads: int) -> Callable[[dict[str, Any]], Standing | None]:
+    """Ours / reference, whole-frame p50 on frames both found, at `threads` threads."""
+
+    def read(results: dict[str, Any]) -> Standing | None:
+        ours, ref = _latency(results, threads, "ours"), _latency(results, threads, "reference")
+        if ours is None or ref is None or ours.get("ratio_p50_x") is None:
+            return None
+        ratio = ours["ratio_p50_x"]
+        return Standing(
+            f"{ratio:.2f} ({ours['p50_ms']:.2f} vs {ref['p50_ms']:.2f} ms)", ratio <= RATIO_GOAL
+        )
+
+    return read
+
+
+def cpu_ratio(results: dict[str, Any], threads: int) -> float | None:
+    """Ours / reference in process CPU-seconds per frame (the energy proxy), or None."""
+    per = {
+        r["side"]: r["cpu_ms_per_frame"] for r in results.get("cpu", []) if r["threads"] == threads
+    }
+    if per.get("ours") is None or not per.get("reference"):
+        return None
+    return per["ours"] / per["reference"]
+
+
+def landmark_error(results: dict[str, Any]) -> Standing | None:
+    """Equal or better in every group the paired interval can judge (and at least one)."""
+    rows = results.get("landmark_error")
+    if rows is None:
+        return None
+    judged = [r for r in rows if r.get("verdict") is not None]
+    if not judged:
+        return Standing("no group both sides found", False)
+    count = {v: sum(r["verdict"] == v for r in judged) for v in ("better", "equal", "worse")}
+    text = (
+        f"{len(judged)} judged (group x landmarks): {count['better']} better, "
+        f"{count['equal']} equal, {count['worse']} worse"
+    )
+    worse = [f"{r['group']} {r['landmarks']}" for r in judged if r["verdict"] == "worse"]
+    if worse:
+        text += f" (worse: {', '.join(worse)})"
+    return Standing(text, not worse)
+
+
+def scenario_fps(results: dict[str, Any]) -> Standing | None:
+    """Median fps of a whole scenario run on one core, sun's shadows, no ablation."""
+    for row in results.get("scenario_runs", []):
+        if not row["ablation"] and row["shadows"]:
+            return Standing(
+                f"{row['fps_median']:.1f} fps ({row['fps_min']:.1f}-{row['fps_max']:.1f} "
+                f"over {row['runs']} runs)",
+                row["fps_median"] >= REALTIME_FPS,
+            )
+    return None
+
+
+GOALS = (
+    Goal(
+        f"whole pipeline <= {RATIO_GOAL}x the reference per frame (p50, frames both found), "
+        "1 thread",
+        "compare_reference",
+        ratio_at(1),
+    ),
+    Goal(
+        f"whole pipeline <= {RATIO_GOAL}x the reference per frame (p50, frames both found), "
+        "2 threads",
+        "compare_reference",
+        ratio_at(2),
+    ),
+    Goal(
+        "landmark error equal or better than the reference (paired 95 % interval)",
+        "compare_reference",
+        landmark_error,
+    ),
+    Goal(
+        f"a scenario run on one core at >= {REALTIME_FPS:g} fps (render + pipeline with 5 "
+        "predictors + truth)",
+        "simulator",
+        scenario_fps,
+    ),
+)

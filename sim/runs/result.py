@@ -1,0 +1,242 @@
+"""The results schema: one run's result line as typed records, with one JSON round trip.
+
+A sweep appends one `RunResult` per finished run to its results file (one JSON object a
+line); metrics, the report and the ground replay read them back as records, so a column
+is named in one place. Per-frame quantities are columns (one list entry per processed
+frame, None where there is nothing to say), rounded where they are written (RunColumns).
+
+Growing it:
+- A new field gets a default (None, an empty list, a default_factory) and is appended to
+  its record; lines written before it load with the default, so SCHEMA stays. Reading
+  code must accept the default (e.g. a behaviour model's head yaw: a column that is None
+  on lines of walkers without one).
+- Several pedestrians: `truth` and each pipeline's columns stay the primary pedestrian's;
+  the others go in a new list field of per-pedestrian truth records (default empty).
+- SCHEMA goes up when a field is renamed, removed or changes meaning or units: lines of
+  another schema are then refused with one line saying how to redo them, never read as
+  if they meant the new thing.
+Measured times live under `timing` only, so everything else is identical whichever
+machine or executor ran the run.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import types
+from dataclasses import dataclass, field
+from typing import Any, Union, get_args, get_origin, get_type_hints
+
+from monopic.errors import UserError
+
+SCHEMA = 1
+MAIN = "main"  # the real pipeline: it finds the person itself
+ABLATION = "gtcrop"  # the same pipeline fed the true crop (pose errors vs decision errors)
+
+
+class ResultError(UserError):
+    """A result line that does not fit the schema (where: the field's dotted path)."""
+
+
+@dataclass
+class TruthColumns:
+    """The ground truth the metrics need, per frame."""
+
+    t: list[float | None] = field(default_factory=list)  # s since the start
+    ttc: list[float | None] = field(default_factory=list)  # s to contact, None: none ahead
+    collision: list[int] = field(default_factory=list)  # 1: contact within the horizon
+    contact: list[int] = field(default_factory=list)  # 1: footprints touch now
+    case: list[int] = field(default_factory=list)  # the case of the next second (1-9)
+    phi: list[float | None] = field(default_factory=list)  # true facing angle, degrees
+    range: list[float | None] = field(default_factory=list)  # m from the robot
+    forward: list[float | None] = field(default_factory=list)  # m, robot frame
+    lateral: list[float | None] = field(default_factory=list)  # m, robot frame (left +)
+    height: list[float | None] = field(default_factory=list)  # apparent height, px
+    in_frame: list[int] = field(default_factory=list)
+    visible: list[float | None] = field(default_factory=list)  # share of landmarks in view
+    occluded: list[int] = field(default_factory=list)
+    foot: list[list[float | None] | None] = field(default_factory=list)  # px
+    future: list[list[float | None] | None] = field(default_factory=list)  # m, robot frame
+    robot_speed: list[float | None] = field(default_factory=list)  # m/s
+
+
+@dataclass
+class DecisionColumns:
+    """One predictor's decisions, per frame (None before its first decision)."""
+
+    warn: list[int | None] = field(default_factory=list)
+    case: list[int | None] = field(default_factory=list)
+    foot: list[list[float | None] | None] = field(default_factory=list)  # predicted, px
+    ground: list[list[float | None] | None] = field(default_factory=list)  # predicted, m
+    ttc: list[float | None] = field(default_factory=list)  # predicted time to contact, s
+
+
+@dataclass
+class PipelineColumns:
+    """One pipeline's outputs per frame, its predictors' decisions by key ('rules/image')."""
+
+    found: list[int] = field(default_factory=list)
+    phi: list[float | None] = field(default_factory=list)
+    foot: list[list[float | None] | None] = field(default_factory=list)
+    height: list[float | None] = field(default_factory=list)
+    detector_runs: list[int] = field(default_factory=list)
+    decisions: dict[str, DecisionColumns] = field(default_factory=dict)
+
+
+@dataclass
+class CameraSummary:
+    width: int
+    height: int
+    vertical_fov_deg: float
+    mount_height: float
+    pitch_deg: float
+
+
+@dataclass
+class ScenarioSummary:
+    """What the report groups and prints by; the full scenario is the run's spec."""
+
+    name: str
+    case: int | None
+    robot_speed: float
+    robot_width: float
+    robot_length: float
+    horizon: float
+    dt: float
+    duration: float
+    camera: CameraSummary
+    pedestrian_height: float
+    pedestrian_speed: float
+    occluders: int
+
+
+@dataclass
+class Machine:
+    host: str = "?"
+    cpu: str = "?"
+    cores: int | None = None
+
+
+@dataclass
+class Timing:
+    """Measured times: never part of a result's identity."""
+
+    wall_s: float = 0.0
+    sim_ms: list[float] = field(default_factory=list)  # per frame: world step (+ render)
+    ms: dict[str, dict[str, list[float | None]]] = field(default_factory=dict)  # pipeline-stage
+    machine: Machine = field(default_factory=Machine)
+
+
+@dataclass
+class RunResult:
+    """One run's result line."""
+
+    id: str
+    family: str
+    truth: TruthColumns
+    scenario: ScenarioSummary
+    schema: int = SCHEMA
+    sweep: str = ""
+    file: str = ""
+    kind: str = "case"
+    scale: str = ""
+    params: dict[str, Any] = field(default_factory=dict)
+    seed: int = 0
+    code: str | None = None  # sim.runs.code_version of the code that ran it
+    frames: int = 0
+    contact_time: float | None = None
+    recording: str | None = None  # the kept .rrd, relative to the recordings folder
+    pipelines: dict[str, PipelineColumns] = field(default_factory=dict)  # "main", "gtcrop"
+    timing: Timing = field(default_factory=Timing)
+
+    # JSON key order of a line (the fields above in the order lines have always had).
+    ORDER = (
+        "schema", "id", "sweep", "family", "file", "kind", "scale", "params", "seed", "code",
+        "scenario", "frames", "contact_time", "recording", "truth", "pipelines", "timing",
+    )  # fmt: skip
+
+    def to_json(self) -> dict[str, Any]:
+        """The line as JSON-ready data (plain dicts and lists)."""
+        plain = to_plain(self)
+        return {k: plain[k] for k in self.ORDER}
+
+    def deterministic(self) -> dict[str, Any]:
+        """The line without measured times: equal whichever executor or machine ran it."""
+        return {k: v for k, v in self.to_json().items() if k != "timing"}
+
+    @classmethod
+    def from_json(cls, data: Any, where: str = "result") -> RunResult:
+        """A record from a parsed line; ResultError (one line) when it does not fit."""
+        if not isinstance(data, dict):
+            raise ResultError(f"{where}: expected a JSON object, got {type(data).__name__}")
+        schema = data.get("schema", SCHEMA)
+        if schema != SCHEMA:
+            newer = isinstance(schema, int) and schema > SCHEMA
+            raise ResultError(
+                f"{where}: results schema {schema!r}, this code reads {SCHEMA} "
+                f"({'written by newer code: update this checkout' if newer else 'rerun the sweep'}"
+                " or rerun with `monopic sweep SPEC --restart`)"
+            )
+        return from_plain(cls, data, where)
+
+    def dumps(self) -> str:
+        """One compact JSON line (no newline)."""
+        return json.dumps(self.to_json(), separators=(",", ":"))
+
+
+# -- the generic round trip -------------------------------------------------------------
+
+
+def to_plain(value: Any) -> Any:
+    """Records as dicts (field order), tuples as lists, everything else as is."""
+    if dataclasses.is_dataclass(value) and not isinstance(value, type):
+        return {f.name: to_plain(getattr(value, f.name)) for f in dataclasses.fields(value)}
+    if isinstance(value, dict):
+        return {k: to_plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [to_plain(v) for v in value]
+    return value
+
+
+def from_plain(cls: type, data: Any, where: str) -> Any:
+    """The record `cls` from plain data, recursively; missing fields take their defaults."""
+    if not isinstance(data, dict):
+        raise ResultError(f"{where}: expected an object, got {type(data).__name__}")
+    hints = get_type_hints(cls)
+    kwargs: dict[str, Any] = {}
+    for f in dataclasses.fields(cls):
+        if f.name in data:
+            kwargs[f.name] = _convert(hints[f.name], data[f.name], f"{where}.{f.name}")
+        elif f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING:
+            raise ResultError(f"{where}.{f.name}: missing")
+    return cls(**kwargs)
+
+
+def _holds_record(tp: Any) -> bool:
+    if dataclasses.is_dataclass(tp):
+        return True
+    return any(_holds_record(a) for a in get_args(tp))
+
+
+def _convert(tp: Any, value: Any, where: str) -> Any:
+    if not _holds_record(tp):  # plain data (numbers, strings, lists of them): as read
+        return value
+    if dataclasses.is_dataclass(tp):
+        return from_plain(tp, value, where)
+    origin = get_origin(tp)
+    if origin in (Union, types.UnionType):
+        if value is None:
+            return None
+        (inner,) = [a for a in get_args(tp) if a is not type(None)]
+        return _convert(inner, value, where)
+    if origin is dict:
+        if not isinstance(value, dict):
+            raise ResultError(f"{where}: expected an object, got {type(value).__name__}")
+        _, item = get_args(tp)
+        return {k: _convert(item, v, f"{where}.{k}") for k, v in value.items()}
+    if origin is list:
+        if not isinstance(value, list):
+            raise ResultError(f"{where}: expected a list, got {type(value).__name__}")
+        (item,) = get_args(tp)
+        return [_convert(item, v, f"{where}[{i}]") for i, v in enumerate(value)]
+    raise TypeError(f"{where}: no conversion for {tp!r}")
