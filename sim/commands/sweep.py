@@ -53,8 +53,8 @@ def run(args: argparse.Namespace) -> int:
     from monopic.errors import UserError
     from sim.runs.code_version import code_version
     from sim.runs.executors import local_executor, ray_executor
+    from sim.runs.result import SCHEMA
     from sim.runs.results_file import scan
-    from sim.runs.runner import SCHEMA
     from sim.runs.sweep import expand_spec, load_spec, recordings_folder, run_sweep
 
     if args.address and args.executor != "ray":

@@ -34,6 +34,7 @@ from tqdm import tqdm
 
 from monopic.errors import UserError
 from sim.runs.code_version import code_version
+from sim.runs.result import SCHEMA
 from sim.runs.results_file import ResultsWriter, scan
 from sim.runs.run_spec import RunSpec
 from sim.scenario.files import (
@@ -241,8 +242,6 @@ def run_sweep(
     A results file holding runs of other code (sim.runs.code_version) is not resumed: that
     is an error, or with `restart` the file and its recordings are set aside first.
     """
-    from sim.runs.runner import SCHEMA  # the simulator: loaded only to run
-
     code = code_version()
     runs = expand_spec(spec)
     if ablation is not None:

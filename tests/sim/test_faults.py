@@ -40,9 +40,9 @@ from monopic.cli.main import main
 from monopic.errors import UserError
 from sim.runs.code_version import code_version
 from sim.runs.executors import WORKER_ENV, local_executor, work
-from sim.runs.results_file import ResultsWriter, read_rows
+from sim.runs.result import RunResult
+from sim.runs.results_file import ResultsWriter, read_results
 from sim.runs.run_spec import RunSpec
-from sim.runs.runner import deterministic_part
 from sim.runs.sweep import expand_spec, load_spec, run_sweep
 from sim.world.render import KeptRenderContext
 from tests.paths import ROOT
@@ -246,9 +246,9 @@ def whole_lines(path: Path) -> list[dict]:
 
 
 def by_id(path: Path) -> dict[str, dict]:
-    rows = list(read_rows(path))
-    assert len({r["id"] for r in rows}) == len(rows), "a run twice"
-    return {r["id"]: deterministic_part(r) for r in rows}
+    rows = list(read_results(path))
+    assert len({r.id for r in rows}) == len(rows), "a run twice"
+    return {r.id: r.deterministic() for r in rows}
 
 
 SWEEP_FLAGS = ["--workers", "2"]
@@ -507,7 +507,7 @@ def test_a_sweep_killed_with_sigkill_resumes_without_loss_to_the_same_results(
     rows = by_id(out)
     (done,) = [spec for spec in expand_spec(load_spec(spec_path)) if spec.id not in before.decode()]
     fresh = work(replace(done, record="none", code=code_version()))
-    assert rows[done.id] == deterministic_part(fresh)  # the run done again, as run alone
+    assert rows[done.id] == RunResult.from_json(fresh, "fresh").deterministic()  # as run alone
     assert len(rows) == 2
 
 
