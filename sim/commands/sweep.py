@@ -53,6 +53,7 @@ def run(args: argparse.Namespace) -> int:
     from monopic.errors import UserError
     from sim.runs.code_version import code_version
     from sim.runs.executors import local_executor, ray_executor
+    from sim.runs.result import SCHEMA
     from sim.runs.results_file import scan
     from sim.runs.sweep import expand_spec, load_spec, recordings_folder, run_sweep
 
@@ -73,6 +74,10 @@ def run(args: argparse.Namespace) -> int:
         if other:
             print(f"{out}: {sum(other.values())} of its runs were made by other code "
                   "(a sweep would stop; --restart sets them aside)")  # fmt: skip
+        newer = state.newer_schema(SCHEMA) if state else None
+        if newer:
+            print(f"{out}:{newer[0]}: results of schema {newer[1]}, newer than this code's "
+                  f"{SCHEMA} (a sweep would stop; --restart sets them aside)")  # fmt: skip
         return 0
     if args.executor == "ray":
         executor = ray_executor(args.address)

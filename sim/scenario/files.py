@@ -416,6 +416,13 @@ def _scene(t: TomlTable, preset: RoadLayout) -> tuple[RoadLayout, tuple[float, f
         crosswalk_x=crosswalk_x if crosswalk else None,
         buildings=r.flag("buildings", preset.buildings),
     )
+    if crosswalk and abs(crosswalk_x) > road.length / 2:
+        raise r.error(
+            "crosswalk_x",
+            crosswalk_x,
+            f"the crosswalk would lie off the road (x in [{-road.length / 2:g}, "
+            f"{road.length / 2:g}] m)",
+        )
     r.done()
     t.seen.add("parked_cars")  # read by _parked_cars once the path is known
     t.done()
@@ -445,7 +452,9 @@ def _path(
                 impact_time=t.number("impact_time", positive=True, high=duration, unit="s"),
                 approach=t.number("approach", 4.0, positive=True, high=30.0, unit="m"),
                 then=Then(t.text("then", "walk", tuple(x.value for x in Then))),
-                standstill_distance=t.number("standstill_distance", 4.0, low=0.0, unit="m"),
+                standstill_distance=t.number(
+                    "standstill_distance", 4.0, low=0.0, high=200.0, unit="m"
+                ),
             )
             pedestrian = place_crossing(c, robot, road, speed, looks, footprint, behaviour)
             case = Case.PERPENDICULAR_LEFT if c.side is Side.NEAR else Case.PERPENDICULAR_RIGHT
@@ -456,7 +465,9 @@ def _path(
                 impact_point=t.number("impact_point", low=-5.0, high=6.0),
                 impact_time=t.number("impact_time", positive=True, high=duration, unit="s"),
                 toward=direction == "toward",
-                standstill_distance=t.number("standstill_distance", 4.0, low=0.0, unit="m"),
+                standstill_distance=t.number(
+                    "standstill_distance", 4.0, low=0.0, high=200.0, unit="m"
+                ),
             )
             if not speed > 0:
                 raise PlacementError("pedestrian.speed", speed, "a walking pedestrian needs > 0")
@@ -466,7 +477,7 @@ def _path(
             leg_tables = t.tables("legs")
             legs = tuple(
                 Leg(
-                    at=leg.number("at", low=0.0, unit="s"),
+                    at=leg.number("at", low=0.0, high=duration, unit="s"),
                     speed=leg.number("speed", low=0.0, high=10.0, unit="m/s"),
                     turn_deg=leg.number("turn_deg", 0.0, low=-360.0, high=360.0, unit="degrees"),
                 )
@@ -481,7 +492,7 @@ def _path(
                 speed=speed,
                 looks=looks,
                 legs=legs,
-                start_delay=t.number("start_delay", 0.0, low=0.0, unit="s"),
+                start_delay=t.number("start_delay", 0.0, low=0.0, high=duration, unit="s"),
                 footprint=footprint,
                 behaviour=behaviour,
             )
@@ -543,6 +554,15 @@ def _parked_cars(
     clearance = abs(y) - max(c.width for c in cars) / 2 - robot.width / 2
     if clearance < 0.1:
         raise t.error("y", y, "the parked cars would stand in the robot's path")
+    x0, x1, y0, y1 = street_bounds(road)
+    if not y0 <= y <= y1:
+        raise t.error("y", y, f"the parked cars would stand off the street (y in [{y0:.2f}, "
+                      f"{y1:.2f}] m)")  # fmt: skip
+    for car in cars:
+        if not x0 <= car.x <= x1:
+            key = "x" if placement == "fixed" else "placement"
+            raise t.error(key, t.data.get(key), f"a parked car would stand off the road "
+                          f"(x = {car.x:g} m, the road spans [{x0:g}, {x1:g}] m)")  # fmt: skip
     return cars
 
 
