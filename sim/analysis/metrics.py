@@ -13,6 +13,11 @@ Definitions (the report states them too):
   at least 1 s before contact, "timely" at least 1.7 s (Euro NCAP's forward collision
   warning bar, for car-scale families). A non-collision run is warned when any frame
   warns; near-miss runs are the non-collision runs of near-miss families.
+- Nuisance warnings: warning onsets (a warned frame after an unwarned one) while the
+  truth has no contact ahead at all (no collision course within its lookahead), per
+  hour of such frames with the pedestrian in view: what a driver is bothered with.
+- Flicker: warning episodes that begin within FLICKER_S of the end of the previous one
+  (on, off, on again within a second), as a share of episodes.
 - Latency applied: the pipeline runs in real time on one core: it takes a frame only when
   it is idle, and a frame's warning exists from capture time + that frame's measured
   latency (pose + features + this predictor's share of predict and warning). Frames that
@@ -40,6 +45,7 @@ LEAD_GOAL = 1.0  # s, the issue's goal: warned at least this long before contact
 RANGE_BINS = (0.0, 5.0, 10.0, 15.0, 20.0, 30.0, 50.0, 1e9)  # m
 HEIGHT_BINS = (0.0, 30.0, 60.0, 120.0, 240.0, 1e9)  # px
 RADII = tuple(range(0, 301, 5))  # px, for accuracy against error radius
+FLICKER_S = 1.0  # s: a warning that comes back this soon after it ended flickers
 
 
 def wilson(successes: int, n: int, z: float = Z95) -> tuple[float, float]:
@@ -146,6 +152,12 @@ class RunOutcome:
     onset: float | None  # first warning while on a collision course
     onset_latency: float | None  # the same with the measured latency applied
     frames: FrameCounts
+    behaviour: str = "rail"  # the pedestrian's walker model
+    cues: bool = False  # whether it showed intent cues
+    nuisance_onsets: int = 0  # warning onsets while no contact is ahead at all
+    clear_seconds: float = 0.0  # s in view with no contact ahead (the nuisance exposure)
+    episodes: int = 0  # warning episodes (runs of warned frames)
+    flickers: int = 0  # episodes beginning within FLICKER_S of the previous one's end
 
     @property
     def lead(self) -> float | None:
@@ -239,6 +251,15 @@ def judge_run(row: RunResult, method: str) -> RunOutcome:
         (avail[k] for k in range(n) if warn[k] and on_course[k] and avail[k] is not None), None
     )
     scenario = row.scenario
+    in_view = [bool(v) for v in truth.in_frame]
+    clear = [not c and seen for c, seen in zip(on_course, in_view, strict=True)]
+    onsets = [k for k in range(n) if warn[k] and (k == 0 or not warn[k - 1])]
+    ends = [k for k in range(n) if warn[k] and (k == n - 1 or not warn[k + 1])]
+    flickers = sum(
+        1
+        for previous_end, start in zip(ends[:-1], onsets[1:], strict=False)
+        if truth.t[start] - truth.t[previous_end] <= FLICKER_S + 1e-9
+    )
     return RunOutcome(
         id=row.id,
         family=row.family,
@@ -253,6 +274,12 @@ def judge_run(row: RunResult, method: str) -> RunOutcome:
         onset=onset,
         onset_latency=onset_latency,
         frames=counts,
+        behaviour=scenario.behaviour,
+        cues=scenario.cues,
+        nuisance_onsets=sum(clear[k] for k in onsets),
+        clear_seconds=sum(clear) * scenario.dt,
+        episodes=len(onsets),
+        flickers=flickers,
     )
 
 
@@ -277,6 +304,18 @@ class WarningSummary:
     other_warned: int
     frames: FrameCounts
     leads: tuple[float, ...]
+    nuisance_onsets: int = 0
+    clear_seconds: float = 0.0
+    episodes: int = 0
+    flickers: int = 0
+
+    @property
+    def nuisance_per_hour(self) -> float:
+        return ratio(self.nuisance_onsets, self.clear_seconds / 3600.0)
+
+    @property
+    def flicker_share(self) -> float:
+        return ratio(self.flickers, self.episodes)
 
     @property
     def recall(self) -> float:
@@ -343,6 +382,10 @@ def summarise(method: str, outcomes: Sequence[RunOutcome]) -> WarningSummary:
         other_warned=sum(o.warned for o in other),
         frames=frames,
         leads=tuple(leads),
+        nuisance_onsets=sum(o.nuisance_onsets for o in outcomes),
+        clear_seconds=sum(o.clear_seconds for o in outcomes),
+        episodes=sum(o.episodes for o in outcomes),
+        flickers=sum(o.flickers for o in outcomes),
     )
 
 
@@ -577,6 +620,8 @@ class SweepMetrics:
     frame_sizes: tuple[str, ...]
     machines: tuple[str, ...]
     codes: tuple[str, ...] = ()  # sim.runs.code_version of the runs ("unknown" before it existed)
+    # method -> (walker model, "cues" or "no cues") -> summary
+    by_behaviour: dict[str, dict[tuple[str, str], WarningSummary]] = field(default_factory=dict)
 
 
 def _machine(row: RunResult) -> str:
@@ -608,6 +653,7 @@ def compute(rows: Sequence[RunResult]) -> SweepMetrics:
         by_case=grouped(lambda o: o.case),
         by_speed=grouped(lambda o: round(o.robot_speed, 2)),
         by_scale=grouped(lambda o: o.scale),
+        by_behaviour=grouped(lambda o: (o.behaviour, "cues" if o.cues else "no cues")),
         cases={m: case_summary(rows, m) for m in all_methods},
         positions={m: position_summary(rows, m) for m in all_methods},
         phi={p: phi_summary(rows, p) for p in pipelines},

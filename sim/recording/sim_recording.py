@@ -15,13 +15,16 @@ really going to happen) reads at a glance. Entities added to RunRecording's:
   predicted foot point), world/robot_trail, world/pedestrian (the 33 landmarks as a
   skeleton, the footprint), world/truth/{path,future} (the whole true path; the part
   within the horizon);
-- topdown/image: highway-env's top-down view (sim.envs.crossing.TopDownViewer), every few frames;
-- time series: truth/phi next to features/phi; ttc/truth and ttc/<predictor> (ground mode's
-  predicted time to contact); alarm/truth (contact within the horizon) and
-  alarm/<predictor> (its warning), 0/1 scalars for tools and, on the same entities, a
-  state lane each (StateChange: clear / collision course / contact for the truth; clear /
-  near / WARNING / no decision for a predictor) so warnings line up against the truth at a
-  glance; robot/speed and truth/gap (footprint distance), brake/command (closed loop);
+- topdown/image: highway-env's top-down view (sim.envs.crossing.TopDownViewer), every few
+  frames;
+- time series: truth/phi next to features/phi, and truth/head_yaw (the head turned from
+  the shoulders: a human walker's head checks and turn leads); ttc/truth and
+  ttc/<predictor> (ground mode's predicted time to contact); alarm/truth (contact within
+  the horizon) and alarm/<predictor> (its warning), 0/1 scalars for tools and, on the
+  same entities, a state lane each (StateChange: clear / collision course / contact for
+  the truth; clear / near / WARNING / no decision for a predictor) so warnings line up
+  against the truth at a glance; robot/speed and truth/gap (footprint distance),
+  brake/command (closed loop);
 - events: first frame on a collision course, contact, pose found and lost, each
   predictor's warning onset, and whatever the caller adds (`log_event`).
 
@@ -66,6 +69,7 @@ from sim.world.ground_truth import GroundTruth, footprint_gap, footprints
 from sim.world.world import World, WorldStep
 
 TRUTH_COLOUR = (0, 210, 255)
+HEAD_COLOUR = (120, 120, 255)  # the true head yaw beside the true phi
 ROBOT_COLOUR = (50, 200, 0)
 ZONE_COLOUR = (150, 240, 150)  # the robot's swept zone on the ground
 PEDESTRIAN_COLOUR = (255, 140, 0)
@@ -163,8 +167,8 @@ def sim_blueprint(
                 rrb.Vertical(
                     rrb.TimeSeriesView(
                         origin="/",
-                        contents=["features/phi", "truth/phi"],
-                        name="phi (deg): estimated vs true",
+                        contents=["features/phi", "truth/phi", "truth/head_yaw"],
+                        name="phi (deg): estimated vs true; true head yaw from the shoulders",
                         axis_x=WHOLE_RUN,
                     ),
                     rrb.TimeSeriesView(
@@ -370,6 +374,7 @@ class SimRecording(WholeOrNothing):
         )
         for name, colour, label in (
             ("truth/phi", TRUTH_COLOUR, "true phi"),
+            ("truth/head_yaw", HEAD_COLOUR, "true head yaw from the shoulders (deg)"),
             ("ttc/truth", TRUTH_COLOUR, "true time to contact"),
             ("alarm/truth", TRUTH_COLOUR, "true: contact within the horizon"),
             ("robot/speed", ROBOT_COLOUR, "robot speed"),
@@ -629,6 +634,7 @@ class SimRecording(WholeOrNothing):
     def _log_series(self, truth: GroundTruth) -> None:
         rec = self.rec
         rec.log("truth/phi", rr.Scalars(truth.phi))
+        rec.log("truth/head_yaw", rr.Scalars(math.degrees(truth.head_yaw_shoulders)))
         if truth.time_to_collision is not None:
             rec.log("ttc/truth", rr.Scalars(truth.time_to_collision))
         rec.log("alarm/truth", rr.Scalars(float(truth.collision)))

@@ -62,6 +62,8 @@ class TruthRecorder(Listener):
         c.foot.append(rounded_point(truth.foot_px, 1))
         c.future.append(rounded_point(truth.future_position_robot, 3))
         c.robot_speed.append(rounded(truth.robot.speed, 3))
+        c.head_yaw.append(rounded(math.degrees(truth.head_yaw_shoulders), 1))
+        c.head_yaw_camera.append(rounded(math.degrees(truth.head_yaw_camera), 1))
 
 
 @dataclass

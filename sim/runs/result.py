@@ -58,6 +58,10 @@ class TruthColumns:
     foot: list[list[float | None] | None] = field(default_factory=list)  # px
     future: list[list[float | None] | None] = field(default_factory=list)  # m, robot frame
     robot_speed: list[float | None] = field(default_factory=list)  # m/s
+    # Where the head looks (degrees, + to the pedestrian's left): from the shoulders'
+    # facing, and from the line to the camera (0: at it). Empty on lines before them.
+    head_yaw: list[float | None] = field(default_factory=list)
+    head_yaw_camera: list[float | None] = field(default_factory=list)
 
 
 @dataclass
@@ -108,6 +112,8 @@ class ScenarioSummary:
     pedestrian_height: float
     pedestrian_speed: float
     occluders: int
+    behaviour: str = "rail"  # the pedestrian's walker model (lines before it: rail)
+    cues: bool = False  # whether the walker shows intent cues (head checks, leads)
 
 
 @dataclass

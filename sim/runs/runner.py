@@ -79,6 +79,8 @@ def scenario_summary(s: Scenario) -> ScenarioSummary:
         pedestrian_height=s.pedestrian.looks.height,
         pedestrian_speed=s.pedestrian.speed,
         occluders=len(s.scene.occluders),
+        behaviour=s.pedestrian.behaviour.model,
+        cues=s.pedestrian.behaviour.cues,
     )
 
 

@@ -138,6 +138,15 @@ class Then(StrEnum):
     WALK = "walk"  # keeps walking across
     STOP_AT_KERB = "stop-at-kerb"  # stops short of the kerb (a near miss)
     TURN_AWAY = "turn-away"  # turns at the kerb and walks off along the pavement (a near miss)
+    HESITATE = "hesitate"  # slows at the kerb for a moment, then walks on across
+    STAND = "stand"  # stands at the kerb facing the road and never crosses (a near miss)
+
+
+# A hesitation at the kerb (assumed): the pedestrian slows to this speed for this long.
+HESITATE_SPEED = 0.3  # m/s
+HESITATE_TIME = 1.0  # s
+# Where a turn-in walker walks along the pavement: this far behind the kerb line.
+PAVEMENT_LINE = 1.0  # m
 
 
 @dataclass(frozen=True)
@@ -155,6 +164,26 @@ class Crossing:
     approach: float  # m walked from the start to the impact point's lateral position
     then: Then = Then.WALK
     standstill_distance: float = 4.0  # m between a standing robot's front and the line
+    # Set: the pedestrian stands this far behind the kerb line (replaces `approach`).
+    from_kerb: float | None = None
+    hesitate_speed: float = HESITATE_SPEED
+    hesitate_time: float = HESITATE_TIME
+
+
+@dataclass(frozen=True)
+class TurnIn:
+    """A pedestrian walking along the pavement who turns into the road and crosses it.
+
+    It walks on the pavement PAVEMENT_LINE behind the kerb of `side`, with the robot
+    (`toward` False) or against it, turns a quarter turn at the crossing line and crosses
+    so that the robot's front strikes it at `impact_point` at `impact_time`.
+    """
+
+    side: Side
+    impact_point: float
+    impact_time: float
+    toward: bool = False
+    standstill_distance: float = 4.0
 
 
 @dataclass(frozen=True)
@@ -228,7 +257,30 @@ def place_crossing(
     entering_edge = -direction * robot.width / 2
     y_impact = entering_edge + direction * c.impact_point * robot.width
     x_line = crossing_line_x(robot, footprint, c.impact_time, c.standstill_distance)
+    y_right, y_left = road.edges
+    kerb = y_right if direction > 0 else y_left
+    y_stop = kerb - direction * (footprint / 2 + KERB_STOP_GAP)  # just short of the kerb
+    if c.from_kerb is not None:
+        c = replace(c, approach=(y_impact - (y_stop - direction * c.from_kerb)) * direction)
+        if c.approach <= 0:
+            raise PlacementError(
+                "path.from_kerb", c.from_kerb, "the start is past the impact point"
+            )
+    if c.then is Then.STAND:  # it never walks: standing where it would set off, facing the road
+        return PedestrianSpec(
+            x=x_line, y=y_impact - direction * c.approach, heading_deg=90.0 * direction,
+            speed=0.0, looks=looks, footprint=footprint, behaviour=behaviour,
+        )  # fmt: skip
     walk_time = time_to_walk(c.approach, speed, accel)
+    if c.then is Then.HESITATE:
+        to_kerb = c.approach - (y_impact - y_stop) * direction
+        slow_distance = c.hesitate_speed * c.hesitate_time
+        if not (to_kerb > 0 and to_kerb + slow_distance < c.approach):
+            raise PlacementError(
+                "path.approach", c.approach,
+                "the hesitation at the kerb must come after the start and before the impact point",
+            )  # fmt: skip
+        walk_time += c.hesitate_time - slow_distance / speed
     start_delay = c.impact_time - walk_time
     if start_delay < 0:
         raise PlacementError(
@@ -239,10 +291,10 @@ def place_crossing(
         )
     y0 = y_impact - direction * c.approach
     legs: tuple[Leg, ...] = ()
-    if c.then is not Then.WALK:
-        y_right, y_left = road.edges
-        kerb = y_right if direction > 0 else y_left
-        y_stop = kerb - direction * (footprint / 2 + KERB_STOP_GAP)
+    if c.then is Then.HESITATE:
+        at = start_delay + time_to_walk((y_stop - y0) * direction, speed, accel)
+        legs = (Leg(at, c.hesitate_speed), Leg(at + c.hesitate_time, speed))
+    elif c.then is not Then.WALK:
         to_kerb = (y_stop - y0) * direction
         if to_kerb <= 0:
             raise PlacementError(
@@ -295,6 +347,41 @@ def place_longitudinal(
         footprint=footprint,
         behaviour=behaviour or Behaviour(),
         anchor=anchor,
+    )
+
+
+def place_turn_in(
+    c: TurnIn, robot: RobotSpec, road: RoadLayout, speed: float, looks: MannequinSpec,
+    footprint: float = 0.5, behaviour: Behaviour | None = None,
+) -> PedestrianSpec:  # fmt: skip
+    """The pedestrian of a turn-in (see TurnIn): walking from the start, one leg: the turn."""
+    if not speed > 0:
+        raise PlacementError("pedestrian.speed", speed, "a walking pedestrian needs > 0")
+    direction = 1.0 if c.side is Side.NEAR else -1.0  # +1 crosses north
+    entering_edge = -direction * robot.width / 2
+    y_impact = entering_edge + direction * c.impact_point * robot.width
+    x_line = crossing_line_x(robot, footprint, c.impact_time, c.standstill_distance)
+    y_right, y_left = road.edges
+    kerb = y_right if direction > 0 else y_left
+    y_walk = kerb - direction * (footprint / 2 + KERB_STOP_GAP + PAVEMENT_LINE)
+    t_turn = c.impact_time - (y_impact - y_walk) * direction / speed
+    if t_turn <= 0:
+        raise PlacementError(
+            "path.impact_time", c.impact_time, "too early: it would turn before the run starts"
+        )
+    along = -1.0 if c.toward else 1.0  # with the robot: east
+    heading = 180.0 if c.toward else 0.0
+    turn = (90.0 * direction) * (1.0 if not c.toward else -1.0)
+    return PedestrianSpec(
+        x=x_line - along * speed * t_turn,
+        y=y_walk,
+        heading_deg=heading,
+        speed=speed,
+        looks=looks,
+        legs=(Leg(t_turn, speed, turn),),
+        footprint=footprint,
+        behaviour=behaviour or Behaviour(),
+        anchor=Anchor(c.impact_time, x_line, y_impact),
     )
 
 

@@ -25,6 +25,8 @@ from sim.scenario.cases import PLACEMENT_FIELDS, CasePlacement
 from sim.scenario.families import (
     BODIES,
     CLOTHING,
+    HESITATE_SPEED,
+    HESITATE_TIME,
     LIGHTING,
     SCALES,
     SHADOWLESS,
@@ -34,11 +36,13 @@ from sim.scenario.families import (
     Scale,
     Side,
     Then,
+    TurnIn,
     crossing_line_x,
     mannequin,
     parked_cars_around,
     place_crossing,
     place_longitudinal,
+    place_turn_in,
     street_bounds,
 )
 from sim.scenario.path import pedestrian_path
@@ -57,7 +61,7 @@ from sim.scenario.spec import (
 from sim.scenario.toml_table import MISSING, FieldError, TomlTable, read_toml, show
 
 KINDS = ("case", "collision", "near-miss")
-PATH_KINDS = ("case", "crossing", "longitudinal", "explicit")
+PATH_KINDS = ("case", "crossing", "longitudinal", "turn-in", "explicit")
 SAMPLING = ("grid", "random")
 MAX_GRID_RUNS = 100_000
 
@@ -360,6 +364,24 @@ def _behaviour(t: TomlTable) -> Behaviour:
         ),  # fmt: skip
         sway=t.number("sway", base.sway, low=0.0, high=0.1, unit="m"),
         surge=t.number("surge", base.surge, low=0.0, high=0.3),
+        head_check_probability=t.number(
+            "head_check_probability", base.head_check_probability, low=0.0, high=1.0
+        ),
+        head_check_lead=t.number(
+            "head_check_lead", base.head_check_lead, low=0.0, high=5.0, unit="s"
+        ),  # fmt: skip
+        head_check_duration=t.number(
+            "head_check_duration", base.head_check_duration, low=0.2, high=5.0, unit="s"
+        ),  # fmt: skip
+        head_check_amplitude=t.number(
+            "head_check_amplitude", base.head_check_amplitude, low=0.0, high=120.0, unit="deg"
+        ),  # fmt: skip
+        head_check_interval=t.number(
+            "head_check_interval", base.head_check_interval, low=0.0, high=30.0, unit="s"
+        ),  # fmt: skip
+        torso_share=t.number("torso_share", base.torso_share, low=0.0, high=1.0),
+        turn_lead=t.number("turn_lead", base.turn_lead, low=0.0, high=2.0, unit="s"),
+        stop_lead=t.number("stop_lead", base.stop_lead, low=0.0, high=3.0, unit="s"),
     )
     t.done()
     return behaviour
@@ -457,10 +479,30 @@ def _path(
                 standstill_distance=t.number(
                     "standstill_distance", 4.0, low=0.0, high=200.0, unit="m"
                 ),
+                from_kerb=t.number("from_kerb", None, low=0.0, high=10.0, unit="m"),
+                hesitate_speed=t.number(
+                    "hesitate_speed", HESITATE_SPEED, positive=True, high=2.0, unit="m/s"
+                ),
+                hesitate_time=t.number(
+                    "hesitate_time", HESITATE_TIME, positive=True, high=10.0, unit="s"
+                ),
             )
             pedestrian = place_crossing(c, robot, road, speed, looks, footprint, behaviour)
             case = Case.PERPENDICULAR_LEFT if c.side is Side.NEAR else Case.PERPENDICULAR_RIGHT
             x_line = crossing_line_x(robot, footprint, c.impact_time, c.standstill_distance)
+        elif kind == "turn-in":
+            c3 = TurnIn(
+                side=Side(t.text("side", choices=tuple(s.value for s in Side))),
+                impact_point=t.number("impact_point", low=-5.0, high=6.0),
+                impact_time=t.number("impact_time", positive=True, high=duration, unit="s"),
+                toward=t.text("direction", "away", ("away", "toward")) == "toward",
+                standstill_distance=t.number(
+                    "standstill_distance", 4.0, low=0.0, high=200.0, unit="m"
+                ),
+            )
+            pedestrian = place_turn_in(c3, robot, road, speed, looks, footprint, behaviour)
+            case = Case.PERPENDICULAR_LEFT if c3.side is Side.NEAR else Case.PERPENDICULAR_RIGHT
+            x_line = crossing_line_x(robot, footprint, c3.impact_time, c3.standstill_distance)
         elif kind == "longitudinal":
             direction = t.text("direction", "away", ("away", "toward"))
             c2 = Longitudinal(

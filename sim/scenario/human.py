@@ -146,6 +146,9 @@ def _sines(table: np.ndarray, x: np.ndarray) -> np.ndarray:
     return np.sum(table[:, 2] * np.sin(2 * math.pi * x / table[:, 0] + table[:, 1]), axis=-1)
 
 
+STOP_APPROACH = 0.6  # share of its speed a walker slows to over `stop_lead` before a stop
+
+
 @dataclass
 class Walk:
     """The walker's distance along the route over time, H seconds at a time."""
@@ -155,17 +158,21 @@ class Walk:
     speed_wander: np.ndarray  # _wander table, over time since setting off
 
     def profile(self, t_start: float, s_start: float, t_end: float, until_s: float = math.inf):
-        """(times, arc lengths) from setting off at `t_start` at arc length `s_start`, to
-        t_end (or until the arc length passes `until_s`)."""
+        """(times, arc lengths, events) from setting off at `t_start` at arc length
+        `s_start`, to t_end (or until the arc length passes `until_s`). Events are
+        (time, kind): "set-off" (from standing), "stop" (arrived at a stop), "slow" (a
+        slower stretch begins: a hesitation)."""
         plan, b = self.plan, self.b
         walking = [k for k, p in enumerate(plan) if p.speed > 0]
         if not walking:
-            return np.array([t_start]), np.array([s_start])
+            return np.array([t_start]), np.array([s_start]), []
         i = walking[0]
         t, s, v = t_start, s_start, 0.0
         mode, t0, v0, duration = "ramp", t, 0.0, b.start_time
         s_stop = hold_until = math.inf
+        approach_from = math.inf  # when the slowing before a stop began
         times, arcs = [t], [s]
+        events: list[tuple[float, str]] = [(t_start, "set-off")]
         steps = max(1, math.ceil((t_end - t_start) / H))
         wander = 1 + b.speed_wander * _sines(self.speed_wander, np.arange(steps + 1) * H)
         for step in range(1, steps + 1):
@@ -173,9 +180,14 @@ class Walk:
                 break
             t = t_start + step * H
             v_before = v
-            cruise = plan[i].speed * float(wander[step])
+            slowing = 1.0
+            if t > approach_from:  # the last steps before a stop: slower
+                tau = min((t - approach_from) / b.stop_lead, 1.0)
+                slowing = 1 - (1 - STOP_APPROACH) * (1 - math.cos(math.pi * tau)) / 2
+            cruise = plan[i].speed * float(wander[step]) * slowing
             if mode == "hold" and t >= hold_until:
                 mode, t0, v0, duration = "ramp", t - H, 0.0, b.start_time
+                events.append((t - H, "set-off"))
             if mode == "ramp":
                 tau = min((t - t0) / duration, 1.0)
                 v = v0 + (cruise - v0) * (1 - math.cos(math.pi * tau)) / 2
@@ -191,6 +203,8 @@ class Walk:
             s += (v_before + v) / 2 * H
             if mode == "brake" and (t - t0) >= duration:
                 s, v = s_stop, 0.0
+                events.append((t, "stop"))
+                approach_from = math.inf
                 nxt = i + 2  # past the standing stretch
                 if nxt < len(plan) and plan[nxt].speed > 0:
                     i, mode, hold_until = nxt, "hold", plan[nxt].time
@@ -200,17 +214,24 @@ class Walk:
                 nxt = plan[i + 1]
                 if nxt.speed == 0:
                     remaining = nxt.s0 - s
+                    # Slowing first: over stop_lead to STOP_APPROACH, then the braking.
+                    slow_down = v * b.stop_lead * (1 + STOP_APPROACH) / 2
+                    reach = v * b.stop_time / 2 * STOP_APPROACH + slow_down
+                    if b.stop_lead > 0 and approach_from == math.inf and remaining <= reach:
+                        approach_from = t
                     if remaining <= v * (b.stop_time / 2 + H):  # brake now to stop there
                         mode, t0, v0, s_stop = "brake", t, v, nxt.s0
                         duration = max(2 * max(remaining, 0.0) / max(v, 1e-9), H)
                 elif s >= nxt.s0:
                     change = abs(nxt.speed - plan[i].speed) / max(nxt.speed, plan[i].speed)
+                    if nxt.speed < plan[i].speed:
+                        events.append((t, "slow"))
                     i += 1
                     if change > 1e-9:
                         mode, t0, v0, duration = "ramp", t, v, max(b.start_time * change, H)
             times.append(t)
             arcs.append(s)
-        return np.array(times), np.array(arcs)
+        return np.array(times), np.array(arcs), events
 
 
 def set_off_time(spec: PedestrianSpec, seed: int) -> float:
@@ -224,9 +245,9 @@ def set_off_time(spec: PedestrianSpec, seed: int) -> float:
         return -PREROLL  # walking at t = 0: it set off long before
     if spec.anchor is None:
         return first.time
-    s_anchor = first.speed * (spec.anchor.time - first.time)  # along the approach
+    s_anchor = _arc_at(plan, spec.anchor.time)  # where the plan is then, along the route
     walk = Walk(plan, b, _tables(seed)[0])
-    times, arcs = walk.profile(0.0, 0.0, spec.anchor.time + 4 * b.start_time + 10.0, s_anchor)
+    times, arcs, _ = walk.profile(0.0, 0.0, spec.anchor.time + 4 * b.start_time + 20.0, s_anchor)
     if not (0 < s_anchor <= arcs[-1]):
         return first.time
     return spec.anchor.time - float(np.interp(s_anchor, arcs, times))
@@ -246,15 +267,18 @@ def human_track(spec: PedestrianSpec, t_end: float, seed: int, t_start: float) -
     speed_table, line_table = _tables(seed)
     plan = stretches(spec)
     walk = Walk(plan, b, speed_table)
-    times, arcs = walk.profile(t_start, 0.0, t_end + H)
+    times, arcs, events = walk.profile(t_start, 0.0, t_end + H)
     if t_start < 0:  # at t = 0 it is at arc length 0, where the plan starts
         offset = float(np.interp(0.0, times, arcs))
-        times, arcs = walk.profile(t_start, -offset, t_end + H)
+        times, arcs, events = walk.profile(t_start, -offset, t_end + H)
         at_zero = float(np.interp(0.0, times, arcs))
         keep = times > 1e-6
         times, arcs = np.concatenate([[0.0], times[keep]]), np.concatenate([[at_zero], arcs[keep]])
-    elif t_start > 1e-6:  # standing where the plan starts until it sets off
-        times, arcs = np.concatenate([[0.0], times]), np.concatenate([[0.0], arcs])
+    elif t_start > 1e-6:  # standing where the plan starts until it sets off (a vertex every
+        # H seconds too: the head may turn while it stands)
+        standing = np.arange(0.0, t_start - H / 2, H)
+        times = np.concatenate([standing, times])
+        arcs = np.concatenate([np.zeros(len(standing)), arcs])
     else:
         times = times - times[0]
     path = route(spec, plan, b.max_yaw_rate)
@@ -288,4 +312,84 @@ def human_track(spec: PedestrianSpec, t_end: float, seed: int, t_start: float) -
     if len(times) > 1 and moving[-1]:
         end = steps[-1] / (times[-1] - times[-2])
         yaws[-1] = yaws[-2]
-    return Track.from_vertices(times, points, yaws, end, footprint_yaws=tangents, phases=phases)
+    head, torso = intent_cues(b, times, tangents, speeds, events, seed)
+    return Track.from_vertices(
+        times, points, yaws, end, footprint_yaws=tangents, phases=phases, head_yaws=head,
+        torso_yaws=torso,
+    )  # fmt: skip
+
+
+def _arc_at(plan: list[Stretch], t: float) -> float:
+    """The plan's arc length at time t (its instant starts and stops)."""
+    s = 0.0
+    for p in plan:
+        if p.time > t:
+            break
+        s = p.s0 + p.speed * (t - p.time)
+    return s
+
+
+TRAFFIC_FROM = math.pi  # world heading toward the traffic that approaches (the robot drives east)
+CHECK_AFTER_STOP = 0.2  # s after arriving at a stop that a check begins
+
+
+def _bump(u: np.ndarray) -> np.ndarray:
+    """A head check's shape over its duration (u in [0, 1]): out, held, back."""
+    rise = np.clip(u / 0.3, 0.0, 1.0)
+    fall = np.clip((1.0 - u) / 0.3, 0.0, 1.0)
+    shape = (1 - np.cos(np.pi * np.minimum(rise, fall))) / 2
+    return np.where((u >= 0) & (u <= 1), shape, 0.0)
+
+
+def intent_cues(
+    b: Behaviour,
+    times: np.ndarray,
+    path_yaws: np.ndarray,
+    speeds: np.ndarray,
+    events: list[tuple[float, str]],
+    seed: int,
+) -> tuple[np.ndarray, np.ndarray]:
+    """(head turned from the shoulders, shoulders turned from the walking line), radians.
+
+    Head checks toward the traffic: `head_check_lead` before setting off, just after
+    arriving at a stop, at a slower stretch (a hesitation), and every
+    `head_check_interval` while walking or standing; each with `head_check_probability`,
+    its own draw from the seed. The shoulders follow `torso_share` of a check. In turns
+    the head looks `turn_lead` ahead along the walking line, the shoulders half as far.
+    Nothing here moves the walker: the cues turn its head and shoulders only.
+    """
+    rng = np.random.default_rng([int(seed), 0x4943])  # "IC"
+    yaw = np.unwrap(path_yaws)
+    checks = np.zeros(len(times))
+    p, duration = b.head_check_probability, b.head_check_duration
+    starts: list[float] = []
+    for t, kind in events:
+        if kind == "set-off":
+            starts.append(t - b.head_check_lead)
+        elif kind == "stop":
+            starts.append(t + CHECK_AFTER_STOP)
+        else:
+            starts.append(t)
+    walking = speeds > 0.5
+    t_end = float(times[-1])
+    k = 1
+    while b.head_check_interval > 0 and k * b.head_check_interval < t_end:
+        t = k * b.head_check_interval
+        i = min(int(np.searchsorted(times, t)), len(times) - 1)
+        if walking[i] or not walking.any():
+            starts.append(t)
+        k += 1
+    for start in sorted(starts):
+        if rng.uniform() >= p or start + duration <= 0:
+            continue
+        i = min(max(int(np.searchsorted(times, start)), 0), len(times) - 1)
+        toward = float(math.remainder(TRAFFIC_FROM - yaw[i], 2 * math.pi))
+        amplitude = math.copysign(min(math.radians(b.head_check_amplitude), abs(toward)), toward)
+        checks += amplitude * _bump((times - start) / duration)
+    limit = math.radians(b.head_check_amplitude)
+    checks = np.clip(checks, -limit, limit)
+    ahead = np.interp(times + b.turn_lead, times, yaw) - yaw
+    half = np.interp(times + b.turn_lead / 2, times, yaw) - yaw
+    torso = b.torso_share * checks + 0.5 * half
+    head = checks + ahead - torso
+    return head, torso

@@ -43,6 +43,8 @@ class PathState:
     yaw: float  # rad, CCW from east: where the person faces (and walks, when walking)
     velocity: np.ndarray  # (2,) world ground velocity, m/s
     footprint_yaw: float = math.nan  # rad: the square on the ground follows the walking line
+    head_yaw: float = 0.0  # rad, the head turned from the shoulders (a human walker's cues)
+    torso_yaw: float = 0.0  # rad, the shoulders turned from the walking direction
 
     def __post_init__(self) -> None:
         if math.isnan(self.footprint_yaw):
@@ -67,7 +69,8 @@ class Track:
 
     def __init__(self, times: np.ndarray, positions: np.ndarray, velocities: np.ndarray,
                  yaws: np.ndarray, footprint_yaws: np.ndarray | None = None,
-                 phases: np.ndarray | None = None) -> None:  # fmt: skip
+                 phases: np.ndarray | None = None, head_yaws: np.ndarray | None = None,
+                 torso_yaws: np.ndarray | None = None) -> None:  # fmt: skip
         self.times = np.asarray(times, dtype=float)
         self.positions = np.asarray(positions, dtype=float).reshape(-1, 2)
         self.velocities = np.asarray(velocities, dtype=float).reshape(-1, 2)
@@ -76,9 +79,13 @@ class Track:
         # The stride phase (strides since some start, unwrapped) where the walk sets it;
         # None: the mannequin's gait keeps its own phase.
         self.phases = None if phases is None else np.asarray(phases, dtype=float)
+        # Intent cues at the vertices (radians, interpolated between them); None: none.
+        self.head_yaws = None if head_yaws is None else np.asarray(head_yaws, dtype=float)
+        self.torso_yaws = None if torso_yaws is None else np.asarray(torso_yaws, dtype=float)
         n = len(self.times)
         arrays = (self.positions, self.velocities, self.yaws, self.footprint_yaws)
-        sizes = {len(a) for a in arrays + (() if self.phases is None else (self.phases,))}
+        optional = (self.phases, self.head_yaws, self.torso_yaws)
+        sizes = {len(a) for a in arrays + tuple(a for a in optional if a is not None)}
         if not (n >= 1 and sizes == {n}):
             raise ValueError("a track needs as many positions, velocities and yaws as times")
         if self.times[0] != 0.0 or np.any(np.diff(self.times) <= 0):
@@ -87,7 +94,8 @@ class Track:
     @classmethod
     def from_vertices(cls, times: np.ndarray, positions: np.ndarray, yaws: np.ndarray,
                       end_velocity: np.ndarray, footprint_yaws: np.ndarray | None = None,
-                      phases: np.ndarray | None = None) -> Track:  # fmt: skip
+                      phases: np.ndarray | None = None, head_yaws: np.ndarray | None = None,
+                      torso_yaws: np.ndarray | None = None) -> Track:  # fmt: skip
         """Pieces joining the vertices; the last one goes on at `end_velocity`."""
         times = np.asarray(times, dtype=float)
         positions = np.asarray(positions, dtype=float).reshape(-1, 2)
@@ -96,7 +104,7 @@ class Track:
             velocities[:-1] = np.diff(positions, axis=0) / np.diff(times)[:, None]
         velocities[-1] = end_velocity
         return cls(times, positions, velocities, np.asarray(yaws, dtype=float), footprint_yaws,
-                   phases)  # fmt: skip
+                   phases, head_yaws, torso_yaws)  # fmt: skip
 
     def _piece(self, t: float) -> int:
         if not (math.isfinite(t) and t >= 0):
@@ -108,8 +116,10 @@ class Track:
         k = self._piece(t)
         v = self.velocities[k]
         position = self.positions[k] + (t - self.times[k]) * v
+        head = 0.0 if self.head_yaws is None else float(np.interp(t, self.times, self.head_yaws))
+        torso = 0.0 if self.torso_yaws is None else float(np.interp(t, self.times, self.torso_yaws))
         return PathState(float(t), position, float(self.yaws[k]), v.copy(),
-                         float(self.footprint_yaws[k]))  # fmt: skip
+                         float(self.footprint_yaws[k]), head, torso)  # fmt: skip
 
     def positions_at(self, times: np.ndarray) -> np.ndarray:
         """(n, 2) positions at many times (>= 0) at once."""
@@ -131,7 +141,7 @@ class Track:
 
     def translated(self, offset: np.ndarray) -> Track:
         return Track(self.times, self.positions + offset, self.velocities, self.yaws,
-                     self.footprint_yaws, self.phases)  # fmt: skip
+                     self.footprint_yaws, self.phases, self.head_yaws, self.torso_yaws)  # fmt: skip
 
 
 def plan_pieces(spec: PedestrianSpec) -> list[tuple[float, float, float]]:
@@ -215,8 +225,7 @@ def pedestrian_path(spec: PedestrianSpec, t_end: float, seed: int = 0) -> Track:
     if behaviour.model == "human":
         from sim.scenario.human import human_track, set_off_time
 
-        approach = replace(spec, legs=())
-        t_start = set_off_time(approach, seed)
+        t_start = set_off_time(anchored_plan(spec), seed)
 
         def build(s: PedestrianSpec) -> Track:
             return human_track(s, t_end, seed, t_start)
@@ -230,7 +239,22 @@ def pedestrian_path(spec: PedestrianSpec, t_end: float, seed: int = 0) -> Track:
     track = build(spec)
     anchor = spec.anchor
     if anchor is not None:  # pass the placement's point at its time, exactly
-        reference = build(replace(spec, legs=())) if spec.legs else track
-        miss = np.array([anchor.x, anchor.y]) - reference.state(anchor.time).position
+        reference = anchored_plan(spec)
+        walked = track if reference is spec else build(reference)
+        miss = np.array([anchor.x, anchor.y]) - walked.state(anchor.time).position
         track = track.translated(miss)
     return track
+
+
+def anchored_plan(spec: PedestrianSpec) -> PedestrianSpec:
+    """The plan the anchor belongs to: the whole plan when it passes the anchor (a pause on
+    the way), else its approach (the plan without its legs: it stops or turns first)."""
+    if spec.anchor is None or not spec.legs:
+        return spec
+    b = spec.behaviour
+    accel = b.acceleration_distance if b.model == "rail" else 0.0
+    plan = rail_track(spec, DEFAULT_ACCELERATION_DISTANCE if accel is None else accel)
+    at = plan.state(spec.anchor.time).position
+    if math.hypot(at[0] - spec.anchor.x, at[1] - spec.anchor.y) < 1e-6:
+        return spec
+    return replace(spec, legs=())

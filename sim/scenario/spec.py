@@ -193,10 +193,26 @@ class Behaviour:
     lateral_wander: float = 0.15  # m, amplitude of the sideways wander off the plan's line
     sway: float = 0.02  # m, the body's side-to-side sway once a stride
     surge: float = 0.12  # the body's speed rising and falling twice a stride, share of it
+    # human intent cues (probability 0 and lead times 0: a walker without them, exactly):
+    head_check_probability: float = 0.8  # of each head check toward the traffic
+    head_check_lead: float = 1.0  # s before setting off that the check before it begins
+    head_check_duration: float = 0.8  # s, out and back
+    head_check_amplitude: float = 60.0  # deg of head yaw (the shoulders turn torso_share of it)
+    head_check_interval: float = 1.5  # s between checks while walking or standing
+    torso_share: float = 0.3  # of a head turn the shoulders follow
+    turn_lead: float = 0.4  # s the head leads the walking line in turns (shoulders half of it)
+    stop_lead: float = 0.6  # s of slowing to STOP_APPROACH of the speed before braking to a stop
 
     def __post_init__(self) -> None:
         if self.model not in BEHAVIOURS:
             raise ValueError(f"behaviour model must be one of {', '.join(BEHAVIOURS)}")
+
+    @property
+    def cues(self) -> bool:
+        """Whether this walker shows intent cues (rail targets never do)."""
+        return self.model == "human" and (
+            self.head_check_probability > 0 or self.turn_lead > 0 or self.stop_lead > 0
+        )
 
 
 @dataclass(frozen=True)

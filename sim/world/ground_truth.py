@@ -117,6 +117,9 @@ class GroundTruth:
     facing_yaw_view: float  # rad, heading relative to the line of sight
     beta: float  # rad, shoulder line out of the image plane, in [-pi/2, pi/2]
     phi: float  # deg, the paper's facing angle this implies (2 * beta)
+    # Where the head looks (from the posed mannequin: nose ahead of the ears' midpoint).
+    head_yaw_shoulders: float = 0.0  # rad, head turned from the shoulders' facing (+ left)
+    head_yaw_camera: float = math.nan  # rad, head facing from the line to the camera (0: at it)
 
     @property
     def landmarks_px(self) -> np.ndarray:
@@ -174,6 +177,8 @@ class GroundTruth:
             "facing_yaw_view": self.facing_yaw_view,
             "beta": self.beta,
             "phi": self.phi,
+            "head_yaw_shoulders": self.head_yaw_shoulders,
+            "head_yaw_camera": self.head_yaw_camera,
         }
 
 
@@ -351,3 +356,24 @@ def pedestrian_passed(truth: GroundTruth, robot_length: float, footprint: float)
     """The pedestrian is behind the robot, clear of it: nothing more can happen in this run."""
     clearance = robot_length / 2 + footprint
     return bool(truth.position_robot[0] < -clearance)
+
+
+NOSE, LEFT_EAR, RIGHT_EAR, LEFT_SHOULDER, RIGHT_SHOULDER = 0, 7, 8, 11, 12
+
+
+def head_yaws(landmarks_world: np.ndarray, camera_world: np.ndarray) -> tuple[float, float]:
+    """(head from the shoulders, head from the line to the camera), radians, + to the left.
+
+    The head faces from the ears' midpoint to the nose; the shoulders face square to the
+    line from the right shoulder to the left one. Both on the ground plane.
+    """
+    ears = (landmarks_world[LEFT_EAR, :2] + landmarks_world[RIGHT_EAR, :2]) / 2
+    head = landmarks_world[NOSE, :2] - ears
+    across = landmarks_world[LEFT_SHOULDER, :2] - landmarks_world[RIGHT_SHOULDER, :2]
+    head_yaw = math.atan2(head[1], head[0])
+    shoulders_yaw = math.atan2(-across[0], across[1])  # rotate right-to-left by -90 deg
+    to_camera = camera_world[:2] - ears
+    return (
+        wrap_angle(head_yaw - shoulders_yaw),
+        wrap_angle(head_yaw - math.atan2(to_camera[1], to_camera[0])),
+    )

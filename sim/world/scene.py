@@ -226,6 +226,8 @@ class Scene:
         speed: float = 0.0,
         pose: MannequinPose | None = None,
         sway: bool = True,
+        head_yaw: float = 0.0,
+        torso_yaw: float = 0.0,
     ) -> None:
         """Stand the pedestrian at world (x, y) facing `yaw`.
 
@@ -233,6 +235,8 @@ class Scene:
         the speed is about zero) unless `pose` is given. Advance the phase between
         frames with `self.gait.advance(phase, speed, dt)`. `sway` False: the placement
         itself sways (a human walker's track), so the pelvis does not sway again.
+        `torso_yaw` turns the shoulders from the walking direction and `head_yaw` the head
+        from the shoulders (radians, + to the left): a human walker's intent cues.
         """
         self.pedestrian = PedestrianState(
             float(x), float(y), float(yaw), float(gait_phase), float(speed)
@@ -240,6 +244,12 @@ class Scene:
         body_pose = pose if pose is not None else self.gait.pose(gait_phase, speed)
         if not sway:
             body_pose = replace(body_pose, sway=0.0)
+        if head_yaw or torso_yaw:
+            body_pose = replace(
+                body_pose,
+                waist_yaw=body_pose.waist_yaw + torso_yaw,
+                neck_yaw=body_pose.neck_yaw + head_yaw,
+            )
         self.mannequin.place(self.model, self.data, x, y, yaw, body_pose)
         self._update()
 

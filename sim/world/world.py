@@ -36,6 +36,7 @@ from sim.world.ground_truth import (
     RobotState,
     case_label,
     facing_angles,
+    head_yaws,
     in_image,
     occluded_landmarks,
     polygons_intersect,
@@ -192,6 +193,8 @@ class World(Closing):
             self.pedestrian.gait_phase,
             ped.speed,
             sway=self.pedestrian.body_sways,
+            head_yaw=ped.head_yaw,
+            torso_yaw=ped.torso_yaw,
         )
         truth = self._ground_truth(robot, ped)
         ego = EgoState(self.camera, robot.speed, robot.yaw_rate)
@@ -230,7 +233,10 @@ class World(Closing):
             scene.model, scene.data, camera_world, body.landmarks_world, scene.mannequin.geom_ids
         )
         visible = in_image(camera, body.landmarks_px) & ~hidden
-        facing, facing_view, beta, phi = facing_angles(pose, camera, ped.position, ped.yaw)
+        # The shoulders face the walking direction turned by the walker's cue (if any).
+        shoulders = ped.yaw + ped.torso_yaw
+        facing, facing_view, beta, phi = facing_angles(pose, camera, ped.position, shoulders)
+        head_from_shoulders, head_from_camera = head_yaws(body.landmarks_world, camera_world)
         return GroundTruth(
             time=self.time,
             index=self.index,
@@ -260,4 +266,6 @@ class World(Closing):
             facing_yaw_view=facing_view,
             beta=beta,
             phi=phi,
+            head_yaw_shoulders=head_from_shoulders,
+            head_yaw_camera=head_from_camera,
         )

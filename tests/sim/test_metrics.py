@@ -224,3 +224,22 @@ def test_compute_groups_and_report_files(tmp_path: Path) -> None:
     pngs = sorted(p.name for p in (tmp_path / "rep").glob("*.png"))
     assert sorted(p.name for p in report.plots) == pngs and len(pngs) == 7
     assert "rules/image" in report.headline
+
+
+def test_nuisance_warnings_and_flicker_count_episodes_off_any_collision_course():
+    # 20 frames at 0.1 s, no contact ahead; warned at 2-3, 6 (back 0.3 s after the end:
+    # a flicker) and 18-19 (back 1.2 s later: no flicker), never on a collision course.
+    warn = [0] * 20
+    for k in (2, 3, 6, 18, 19):
+        warn[k] = 1
+    r = judge_run(row("n", [None] * 20, warn, kind="near-miss"), KEY)
+    assert (r.episodes, r.nuisance_onsets, r.flickers) == (3, 3, 1)
+    assert r.clear_seconds == pytest.approx(2.0)
+    s = summarise(KEY, [r])
+    assert s.nuisance_per_hour == pytest.approx(3 / (2.0 / 3600))
+    assert s.flicker_share == pytest.approx(1 / 3)
+    # Warnings while a contact is ahead are not nuisances, and an unwarned run has none.
+    on_course = judge_run(collision_row("c", 9), KEY)
+    assert on_course.nuisance_onsets == 0 and on_course.episodes == 1
+    quiet = judge_run(row("q", [None] * 20, [0] * 20, kind="near-miss"), KEY)
+    assert (quiet.episodes, quiet.nuisance_onsets, quiet.flickers) == (0, 0, 0)

@@ -57,7 +57,9 @@ def test_all_shipped_scenario_files_load_and_name_their_case_or_kind() -> None:
 def test_shipped_sweeps_expand_into_valid_runs_with_unique_ids() -> None:
     demo = expand_spec(load_spec(SCENARIOS / "sweeps" / "demo.toml"))
     large = expand_spec(load_spec(SCENARIOS / "sweeps" / "large.toml"))
-    assert len({r.family for r in demo}) == 21  # the cases and every family
+    families = len(list((SCENARIOS / "families").glob("*/*.toml")))
+    assert families >= 28  # Euro NCAP-style, near-miss and intent families at two scales
+    assert len({r.family for r in demo}) == families + 1  # the cases and every family
     assert len(large) >= 500
     for runs in (demo, large):
         assert len({r.id for r in runs}) == len(runs)

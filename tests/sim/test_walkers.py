@@ -180,3 +180,74 @@ def test_every_collision_and_near_miss_family_has_a_human_version():
         for model in ("rail", "human"):
             scenario = f.scenario({"pedestrian.behaviour.model": model}, f.name, 0)
             assert scenario.pedestrian.behaviour.model == model
+
+
+# -- intent cues (issue 18) ---------------------------------------------------------------
+
+NO_CUES = {"head_check_probability": 0.0, "turn_lead": 0.0, "stop_lead": 0.0}
+
+
+def crossing_spec(**behaviour: float) -> PedestrianSpec:
+    return PedestrianSpec(x=4.0, y=-4.0, heading_deg=90.0, speed=1.4, start_delay=2.0,
+                          behaviour=Behaviour(model="human", **behaviour))  # fmt: skip
+
+
+def test_cues_off_reproduce_the_cue_free_walker_exactly():
+    cued = pedestrian_path(crossing_spec(head_check_probability=1.0, turn_lead=0.5), 8.0, 7)
+    plain = pedestrian_path(crossing_spec(**NO_CUES), 8.0, 7)
+    # Cues turn the head and the shoulders; they never move the walker.
+    assert np.array_equal(cued.positions, plain.positions)
+    assert np.array_equal(cued.yaws, plain.yaws)
+    assert np.all(plain.head_yaws == 0.0) and np.all(plain.torso_yaws == 0.0)
+    assert np.abs(cued.head_yaws).max() > math.radians(30)
+
+
+def test_a_head_check_looks_toward_the_traffic_before_stepping_off_and_at_a_stop():
+    track = pedestrian_path(crossing_spec(head_check_probability=1.0), 8.0, 7)
+    t, v = speeds(track, 0.0, 8.0, dt=0.05)
+    set_off = t[np.flatnonzero(v > 0.05)[0]]
+    before = np.arange(set_off - 1.0, set_off, 0.02)
+    turned = [track.state(float(x)).head_yaw + track.state(float(x)).torso_yaw for x in before]
+    # Facing north, the robot's traffic comes from the west: to the left (+).
+    assert max(turned) == pytest.approx(math.radians(60.0), abs=math.radians(1.0))
+    stop = PedestrianSpec(x=4.0, y=-4.0, heading_deg=90.0, speed=1.4, start_delay=1.0,
+                          legs=(Leg(at=3.0, speed=0.0),),
+                          behaviour=Behaviour(model="human", head_check_probability=1.0,
+                                              head_check_interval=0.0))  # fmt: skip
+    track = pedestrian_path(stop, 8.0, 7)
+    t, v = speeds(track, 0.0, 8.0, dt=0.05)
+    arrived = t[np.flatnonzero(v > 0.05)[-1]]
+    after = [track.state(float(x)).head_yaw for x in np.arange(arrived, arrived + 1.2, 0.02)]
+    assert max(after) > math.radians(30)  # it looks at the kerb too: a cue is not a label
+
+
+def test_the_head_then_the_shoulders_lead_a_turn():
+    quiet = Behaviour(
+        model="human", head_check_probability=0.0, turn_lead=0.5, lateral_wander=0.0, sway=0.0
+    )
+    turn = (Leg(at=2.0, speed=1.4, turn_deg=90.0),)
+    spec = PedestrianSpec(x=0.0, y=-4.0, heading_deg=0.0, speed=1.4, legs=turn, behaviour=quiet)
+    track = pedestrian_path(spec, 6.0, 0)
+    times = np.arange(0.0, 4.0, 0.01)
+    line = np.unwrap([track.state(float(t)).footprint_yaw for t in times])
+    starts = times[np.flatnonzero(np.abs(line - line[0]) > math.radians(2))[0]]
+    head = np.array([track.state(float(t)).head_yaw + track.state(float(t)).torso_yaw
+                     for t in times])  # fmt: skip
+    torso = np.array([track.state(float(t)).torso_yaw for t in times])
+    head_starts = times[np.flatnonzero(head > math.radians(2))[0]]
+    torso_starts = times[np.flatnonzero(torso > math.radians(2))[0]]
+    assert head_starts < torso_starts < starts  # head first, then the shoulders, then the path
+    assert starts - head_starts == pytest.approx(0.5, abs=0.15)
+
+
+def test_the_truth_reads_the_head_yaw_off_the_posed_body():
+    spec = crossing_spec(head_check_probability=1.0, head_check_interval=0.0)
+    from sim.scenario.spec import Scenario
+
+    scenario = Scenario(name="look", pedestrian=spec, duration=4.0)
+    with World(scenario, render=False) as world:
+        seen = [(s.truth.head_yaw_shoulders, world.pedestrian.state.head_yaw)  # type: ignore[union-attr]
+                for s in world.run()]  # fmt: skip
+    measured, commanded = np.array(seen).T
+    assert np.abs(commanded).max() > math.radians(30)
+    assert np.abs(measured - commanded).max() < math.radians(4)  # the gait's counter-rotation
