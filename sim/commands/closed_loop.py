@@ -42,7 +42,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         f"(they meet the robot's front at {MEET_TIME:g} s unless it brakes)",
     )
     p.add_argument("--speeds", default="1,2,3", help="robot speeds, m/s (default 1,2,3)")
-    p.add_argument("--policies", default=DEFAULT_POLICIES, help=f"default {DEFAULT_POLICIES}")
+    p.add_argument(
+        "--policies",
+        default=DEFAULT_POLICIES,
+        help="comma-separated: none, truth, or PREDICTOR/MODE with a predictor's registry "
+        "name (as results and reports name them, e.g. tree/image) and image or ground "
+        "mode (default %(default)s)",
+    )
     p.add_argument(
         "--latency-ms",
         type=non_negative_float,
@@ -107,13 +113,24 @@ def file_scenarios(files: list[Path], speeds: list[float], seed: int) -> list[Sc
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim.runs.closed_loop import NO_BRAKE, format_runs, format_table, run_closed_loop, summarise
+    from sim.runs.closed_loop import (
+        NO_BRAKE,
+        check_policy,
+        format_runs,
+        format_table,
+        run_closed_loop,
+        summarise,
+    )
 
     speeds = _numbers(args.speeds, "--speeds")
     policies = [p.strip() for p in args.policies.split(",") if p.strip()]
+    if not policies:
+        raise UserError(f"--policies: no policy in {args.policies!r}")
     for policy in policies:
-        if policy not in ("none", "truth") and policy.count("/") != 1:
-            raise UserError(f"--policies: {policy!r} is not none, truth or PREDICTOR/MODE")
+        try:
+            check_policy(policy)
+        except ValueError as err:
+            raise UserError(f"--policies: {err}") from None
     if NO_BRAKE not in policies:
         policies.insert(0, NO_BRAKE)  # the baseline every other policy is judged against
     for out in (args.out,):

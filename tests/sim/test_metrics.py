@@ -224,3 +224,15 @@ def test_compute_groups_and_report_files(tmp_path: Path) -> None:
     pngs = sorted(p.name for p in (tmp_path / "rep").glob("*.png"))
     assert sorted(p.name for p in report.plots) == pngs and len(pngs) == 7
     assert "rules/image" in report.headline
+
+
+def test_every_predictor_and_mode_has_its_own_colour_in_the_plots() -> None:
+    """Histograms and bars have no line style: rules/image and rules/ground must differ."""
+    from sim.analysis.plots import style
+    from sim.runs.pipelines import PREDICTORS
+
+    keys = [f"{name}/{mode}" for name, mode in PREDICTORS] + ["tree/ground"]
+    colours = [style(key)["color"] for key in keys]
+    assert len(set(colours)) == len(keys)
+    assert style("gtcrop:rules/image")["color"] == style("rules/image")["color"]
+    assert style("mine/image")["color"] == style("mine/image")["color"] not in colours
