@@ -41,6 +41,7 @@ from sim.scenario.files import (
     ScenarioFileError,
     Sweep,
     expand,
+    is_scenario_file,
     load,
     parse_parameters,
 )
@@ -79,8 +80,15 @@ def load_spec(path: Path | str) -> SweepSpec:
     return parse_spec(path, data)
 
 
-def parse_spec(path: Path, data: Mapping[str, Any], doc: str = "scenarios/README.md") -> SweepSpec:
+def parse_spec(
+    path: Path, data: Mapping[str, Any], doc: str = "scenarios/README.md", what: str = "sweep spec"
+) -> SweepSpec:
     """Check a sweep spec's data (keys SPEC_KEYS); `doc` is where the keys are documented."""
+    if is_scenario_file(data):
+        raise UserError(
+            f"{path}: this is a scenario file, not a {what} (a {what} lists scenario files "
+            f"under [[include]], see {doc}): record it alone with `monopic record {path}`"
+        )
     top = TomlTable(path, "", data, doc)
     name = top.slug("name")
     description = top.text("description", "")

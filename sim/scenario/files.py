@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from monopic.cases import Case
+from monopic.errors import UserError
 from sim.scenario.cases import PLACEMENT_FIELDS, CasePlacement
 from sim.scenario.families import (
     BODIES,
@@ -61,6 +62,22 @@ MAX_GRID_RUNS = 100_000
 
 
 ScenarioFileError = FieldError  # the name callers of this module know
+
+# Top-level keys by which a scenario file and a sweep spec tell themselves apart, so that
+# one given for the other is named for what it is, not for its first unknown key.
+SCENARIO_FILE_KEYS = ("path", "pedestrian", "robot", "scene", "sweep", "family", "kind",
+                      "scale", "duration", "fps", "horizon", "seed")  # fmt: skip
+SWEEP_SPEC_KEY = "include"
+
+
+def is_scenario_file(data: Mapping[str, Any]) -> bool:
+    """The data of a scenario file (it has a scenario's tables and no [[include]])."""
+    return SWEEP_SPEC_KEY not in data and any(k in data for k in SCENARIO_FILE_KEYS)
+
+
+def is_sweep_spec(data: Mapping[str, Any]) -> bool:
+    """The data of a sweep or dataset spec (it has [[include]] and no [path])."""
+    return SWEEP_SPEC_KEY in data and "path" not in data
 
 
 # -- sweeps ---------------------------------------------------------------------------
@@ -246,6 +263,11 @@ def load(path: Path | str) -> ScenarioFile:
     """Read and validate one scenario file (its base scenario and every sweep value)."""
     path = Path(path)
     _, data = read_toml(path, "scenario file")
+    if is_sweep_spec(data):
+        raise UserError(
+            f"{path}: this is a sweep spec, not a scenario file (it lists scenario files "
+            f"under [[include]]): run it with `monopic sweep {path}`"
+        )
     top = TomlTable(path, "", data)
     sweep_table = top.table("sweep") if top.has("sweep") else None
     data.pop("sweep", None)  # the base scenario is the file without its sweep

@@ -1,0 +1,56 @@
+"""Command-line mistakes a newcomer makes: one line that points at the real mistake."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from monopic.cli.main import main
+from tests.paths import SCENARIOS
+
+CASE5 = SCENARIOS / "cases" / "case5_perpendicular_right.toml"
+DEMO = SCENARIOS / "sweeps" / "demo.toml"
+
+
+def one_line_error(capsys: pytest.CaptureFixture[str]) -> str:
+    err = capsys.readouterr().err.strip()
+    assert err and "\n" not in err, err
+    return err
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["sweep", str(CASE5), "--dry-run"], "this is a scenario file, not a sweep spec"),
+        (["dataset", str(CASE5), "--out", "x", "--estimate-only"], "not a dataset spec"),
+        (["record", str(DEMO)], "this is a sweep spec, not a scenario file"),
+        (["closed-loop", str(DEMO)], f"run it with `monopic sweep {DEMO}`"),
+    ],
+)
+def test_a_scenario_file_and_a_sweep_spec_given_for_each_other_are_named(
+    capsys: pytest.CaptureFixture[str], argv: list[str], expected: str
+) -> None:
+    assert main(argv) == 2
+    assert expected in one_line_error(capsys)
+
+
+def test_a_misspelt_required_key_is_named_as_unknown(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    spec = tmp_path / "spec.toml"
+    spec.write_text(f'name = "x"\n[[include]]\nfile = ["{CASE5}"]\n')
+    assert main(["sweep", str(spec), "--dry-run"]) == 2
+    assert one_line_error(capsys) == (
+        f"monopic sweep: error: {spec}: include[0].file = ['{CASE5}']: unknown key, and "
+        "include[0].files is missing: did you mean 'files'?"
+    )
+    spec.write_text(f'name = "x"\n[[include]]\nfiles = ["{CASE5}"]\nsamplng = "grid"\n')
+    assert main(["sweep", str(spec), "--dry-run"]) == 2
+    assert "include[0].samplng = 'grid': unknown key (did you mean 'sampling'? known" in (
+        one_line_error(capsys)
+    )
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(CASE5.read_text().replace('kind = "case"\ncase', 'knid = "case"\ncase'))
+    assert main(["record", str(scenario)]) == 2
+    assert "path.knid = 'case': unknown key, and path.kind is missing" in one_line_error(capsys)
