@@ -54,3 +54,36 @@ def test_a_misspelt_required_key_is_named_as_unknown(
     scenario.write_text(CASE5.read_text().replace('kind = "case"\ncase', 'knid = "case"\ncase'))
     assert main(["record", str(scenario)]) == 2
     assert "path.knid = 'case': unknown key, and path.kind is missing" in one_line_error(capsys)
+
+
+def test_base_sampling_applies_its_parameters_and_refuses_draw_settings(tmp_path: Path) -> None:
+    """sampling = "base" with [include.parameters] used to drop them without a word."""
+    from monopic.errors import UserError
+    from sim.runs.sweep import expand_spec, load_spec
+
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        f'name = "x"\n[[include]]\nfiles = ["{CASE5}"]\nsampling = "base"\n'
+        '[include.parameters]\nduration = [2.0]\n"robot.speed" = [0.0, 1.0]\n'
+    )
+    runs = expand_spec(load_spec(spec))
+    assert [r.params for r in runs] == [
+        {"duration": 2.0, "robot.speed": 0.0},
+        {"duration": 2.0, "robot.speed": 1.0},
+    ]
+    assert {r.scenario.duration for r in runs} == {2.0}
+    assert [r.scenario.robot.speed for r in runs] == [0.0, 1.0]
+    # Without parameters: one run at the file's own values (its 18-run sweep dropped).
+    spec.write_text(f'name = "x"\n[[include]]\nfiles = ["{CASE5}"]\nsampling = "base"\n')
+    (run,) = expand_spec(load_spec(spec))
+    assert run.params == {} and run.scenario.duration == 4.0
+    for sampling, key in (("base", "runs = 3"), ("grid", "seed = 2")):
+        spec.write_text(
+            f'name = "x"\n[[include]]\nfiles = ["{CASE5}"]\nsampling = "{sampling}"\n{key}\n'
+        )
+        with pytest.raises(UserError) as err:
+            load_spec(spec)
+        assert str(err.value) == (
+            f"{spec}: include[0].{key}: draws at random only: "
+            f'sampling = "{sampling}" would ignore it'
+        )
