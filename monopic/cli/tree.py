@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from monopic.cli.args import non_negative_float, positive_int
+from monopic.cli.args import non_negative_float, output_file, positive_int
 from monopic.errors import UserError
 from monopic.replay.dataset import prepare
 from monopic.replay.logs import read_log
@@ -77,9 +77,7 @@ def _train(args: argparse.Namespace) -> int:
         model = train_on_logs(logs, training_options(args))
     except ValueError as err:
         raise UserError(str(err)) from err
-    out: Path = args.out
-    if not out.parent.is_dir():
-        raise UserError(f"{out}: directory {out.parent} does not exist")
+    out = output_file(args.out, "--out")
     save_model(model, out)
     print(summary(model))
     print(f"\nwrote {out}")

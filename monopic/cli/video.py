@@ -12,7 +12,7 @@ import cv2
 from tqdm import tqdm
 
 from monopic.camera import CameraModel
-from monopic.cli.args import non_negative_float, positive_float, positive_int
+from monopic.cli.args import non_negative_float, output_file, positive_float, positive_int
 from monopic.errors import UserError
 from monopic.frame import EgoState
 from monopic.framelog import FRAME_COLUMNS, authors_finite, frame_row
@@ -54,10 +54,15 @@ def run(args: argparse.Namespace) -> int:
     mode = Mode(args.mode)
     if mode is Mode.GROUND and ego is None:
         raise UserError("--mode ground needs the camera geometry: --fov and --camera-height")
-    for out in (args.out, args.csv, args.rrd):
-        if out is not None and not out.parent.is_dir():
-            raise UserError(f"{out}: its folder {out.parent} does not exist")
+    if args.out is None and args.csv is None and args.rrd is None:
+        raise UserError(
+            "nothing to write: give --out VIDEO.mp4, --csv FRAMES.csv and/or --rrd RUN.rrd "
+            "(without them the run would only count the frames with a person)"
+        )
     predictor = make_predictor(args.predictor, mode, args.tree)
+    for option, out in (("--out", args.out), ("--csv", args.csv), ("--rrd", args.rrd)):
+        if out is not None:
+            output_file(out, option)
     pipeline = Pipeline(
         PipelineConfig(
             horizon=args.horizon, mode=mode, tracker=TrackerConfig(threads=args.threads)

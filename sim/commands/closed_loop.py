@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 from tqdm import tqdm
 
-from monopic.cli.args import non_negative_float
+from monopic.cli.args import non_negative_float, output_file, output_folder
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
 
@@ -133,11 +133,6 @@ def run(args: argparse.Namespace) -> int:
             raise UserError(f"--policies: {err}") from None
     if NO_BRAKE not in policies:
         policies.insert(0, NO_BRAKE)  # the baseline every other policy is judged against
-    for out in (args.out,):
-        if out is not None and not out.parent.is_dir():
-            raise UserError(f"{out}: its folder {out.parent} does not exist")
-    if args.rrd_dir is not None and not args.rrd_dir.is_dir():
-        raise UserError(f"--rrd-dir {args.rrd_dir}: no such folder")
     if args.cases:
         if args.files:
             raise UserError("give scenario files or --cases, not both")
@@ -147,6 +142,10 @@ def run(args: argparse.Namespace) -> int:
         files = args.files or [FAMILY_FOLDER / f"{name}.toml" for name in NCAP_FAMILIES]
         scenarios = file_scenarios(files, speeds, args.seed)
         source = ", ".join(str(f) for f in files)
+    if args.out is not None:
+        output_file(args.out, "--out")
+    if args.rrd_dir is not None:
+        output_folder(args.rrd_dir, "--rrd-dir")
     outcomes = []
     with tqdm(total=len(scenarios) * len(policies), unit="run") as bar:
         for scenario in scenarios:

@@ -8,6 +8,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from monopic.cli.args import output_folder
 from monopic.errors import UserError
 
 
@@ -42,11 +43,12 @@ def run(args: argparse.Namespace) -> int:
 
     spec = load_spec(args.spec)
     out: Path = args.out
-    if not out.parent.is_dir():
-        raise UserError(f"--out {out}: its folder {out.parent} does not exist")
     if args.estimate_only:
         print(f"size: {estimate(expand(spec), []).text()}")
         return 0
+    if out.exists() and not out.is_dir():
+        raise UserError(f"--out {out}: is a file, not a dataset folder")
+    output_folder(out.parent, "--out")
     bars: list[tqdm] = []
 
     def progress(total: int) -> Callable[[int], None]:

@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 from tqdm import tqdm
 
 from monopic.cases import Case
+from monopic.cli.args import output_file
 from monopic.errors import UserError
 
 if TYPE_CHECKING:  # the simulator is imported when a command runs, not when the CLI starts
@@ -115,11 +116,7 @@ def run(args: argparse.Namespace) -> int:
     if args.topdown_every < 0:
         raise UserError(f"--topdown-every: must be >= 0, got {args.topdown_every}")
     scenario = resolve_scenario(args.scenario, args)
-    path: Path = args.rrd or DEFAULT_FOLDER / f"{scenario.name}.rrd"
-    if args.rrd is None:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    elif not path.parent.is_dir():
-        raise UserError(f"{path}: its folder {path.parent} does not exist")
+    path = output_file(args.rrd or DEFAULT_FOLDER / f"{scenario.name}.rrd", "--rrd")
     with tqdm(total=scenario.frames, unit="frame", desc=scenario.name) as bar:
         summary = record_run(
             scenario,

@@ -16,6 +16,7 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from monopic.cli.args import output_folder
     from monopic.errors import UserError
     from sim.analysis.metrics import compute
     from sim.analysis.report import ran_on, write_report
@@ -27,9 +28,7 @@ def run(args: argparse.Namespace) -> int:
     rows = list(read_results(results))
     if not rows:
         raise UserError(f"{results}: no finished runs in it yet")
-    out = args.out or results.with_name(f"{results.stem}_report")
-    if out.exists() and not out.is_dir():
-        raise UserError(f"--out {out}: exists and is not a folder")
+    out = output_folder(args.out or results.with_name(f"{results.stem}_report"), "--out")
     metrics = compute(rows)
     report = write_report(metrics, rows, results, out)
     print(report.headline)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from monopic.cli.args import positive_int
+from monopic.cli.args import output_file, positive_int
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -74,6 +74,7 @@ def run(args: argparse.Namespace) -> int:
             print(f"{out}: {sum(other.values())} of its runs were made by other code "
                   "(a sweep would stop; --restart sets them aside)")  # fmt: skip
         return 0
+    output_file(out, "--out")
     if args.executor == "ray":
         executor = ray_executor(args.address)
     else:

@@ -87,3 +87,26 @@ def test_base_sampling_applies_its_parameters_and_refuses_draw_settings(tmp_path
             f"{spec}: include[0].{key}: draws at random only: "
             f'sampling = "{sampling}" would ignore it'
         )
+
+
+def test_every_command_makes_the_folder_its_output_goes_to(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """One rule for output paths (README): a missing folder is created, for tree, replay
+    and report here; video, record, sweep and closed-loop are run so in their own tests
+    and in the README walkthrough (tests/test_walkthrough.py)."""
+    from tests.paths import DATA
+
+    logs = sorted((DATA / "authors").glob("data*.csv"))
+    tree = tmp_path / "a" / "b" / "tree.json"
+    assert main(["tree", "train", *map(str, logs[:2]), "--out", str(tree)]) == 0
+    assert tree.is_file()
+    table = tmp_path / "c" / "d" / "pred.csv"
+    assert main(["replay", str(logs[2]), "--tree", str(tree), "--csv", str(table)]) == 0
+    assert table.read_text().count("\n") > 10
+    capsys.readouterr()
+    (tmp_path / "plain").write_text("x")
+    assert main(["tree", "train", str(logs[0]), "--out", str(tmp_path / "plain" / "t.json")]) == 2
+    assert one_line_error(capsys).endswith("a file is in the way of this folder")
+    assert main(["tree", "train", str(logs[0]), "--out", str(tmp_path)]) == 2
+    assert one_line_error(capsys).endswith(f"--out {tmp_path}: is a folder; give a file name")
