@@ -36,6 +36,7 @@ import io
 import json
 import math
 import shutil
+import time
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -55,6 +56,7 @@ from monopic.predict.rules import RulePredictor
 from sim.dataset.card import readme
 from sim.dataset.coco import SKELETONS, category, encode_mask, mask_box, select_keypoints
 from sim.dataset.spec import FORMAT_VERSION, JPEG_QUALITY, DatasetRun, DatasetSpec, expand
+from sim.runs.estimate import TimeEstimate, bench_frame_seconds, estimate_time
 from sim.runs.loop import Listener, LoopFrame, OnBoard, Progress, run_loop
 from sim.runs.sweep import SweepSpec
 from sim.scenario.spec import CameraSpec, Scenario
@@ -191,6 +193,7 @@ def render_run(
 
     `kept`: a GL context lent from run to run (sim.world.render), else the run makes its own.
     """
+    start = time.perf_counter()
     scenario = run.scenario
     cam = scenario.robot.camera
     for sub in ("images", "masks"):
@@ -227,6 +230,7 @@ def render_run(
         "annotations": writer.annotations,
     }
     record["bytes"] = _run_bytes(out, run.id)
+    record["seconds"] = round(time.perf_counter() - start, 3)  # measured: for time estimates
     write_text_atomically(out / "runs" / f"{run.id}.json", json.dumps(record, default=_plain))
     return record
 
@@ -281,6 +285,17 @@ def estimate(runs: list[DatasetRun], finished: list[dict[str, Any]]) -> SizeEsti
     guess = sum(r.scenario.frames * _frame_bytes(r.scenario.robot.camera) for r in runs)
     per = guess / frames if frames else _frame_bytes(CameraSpec())
     return SizeEstimate(len(runs), frames, per, False)
+
+
+def estimate_duration(todo: list[DatasetRun], finished: list[dict[str, Any]]) -> TimeEstimate:
+    """The time the runs still to render take (one process renders them, one after another):
+    measured on the finished runs' own times, else the benchmark (sim.runs.estimate)."""
+    return estimate_time(
+        [(r.scenario.frames, bench_frame_seconds(r.scenario.robot.camera, False)) for r in todo],
+        [(r["frames"], r.get("seconds", 0.0)) for r in finished],
+        workers=1,
+        measured_where="of this dataset",
+    )
 
 
 def _frame_bytes(cam: CameraSpec) -> float:
@@ -351,6 +366,7 @@ def build(
     size = estimate(runs, list(done.values()))
     report(f"size: {size.text()}")
     report(f"{len(done)} of {len(runs)} runs already finished, {len(todo)} to render")
+    report(f"time: {estimate_duration(todo, list(done.values())).text()}")
     on_frame = progress(sum(r.scenario.frames for r in todo)) if progress and todo else None
     with KeptRenderContext() as kept:
         for run in todo:

@@ -110,3 +110,80 @@ def test_every_command_makes_the_folder_its_output_goes_to(
     assert one_line_error(capsys).endswith("a file is in the way of this folder")
     assert main(["tree", "train", str(logs[0]), "--out", str(tmp_path)]) == 2
     assert one_line_error(capsys).endswith(f"--out {tmp_path}: is a folder; give a file name")
+
+
+TINY = """
+name = "tiny"
+kind = "collision"
+duration = 0.4
+[robot.camera]
+width = 256
+height = 144
+[path]
+kind = "case"
+case = 5
+distance = 3.0
+[sweep]
+sampling = "grid"
+[sweep.parameters]
+"robot.speed" = [0.0, 1.0, 2.0]
+"""
+
+
+def test_dry_run_shows_runs_per_family_and_a_time_it_says_how_it_computed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import json
+
+    (tmp_path / "tiny.toml").write_text(TINY)
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        f'name = "t"\n[[include]]\nfiles = ["tiny.toml", "{CASE5}"]\nsampling = "base"\n'
+    )
+    out = tmp_path / "r.jsonl"
+    assert main(["sweep", str(spec), "--out", str(out), "--dry-run", "--workers", "2"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == f"{spec}: 2 runs in 2 families, 0 already in {out}, 2 to run"
+    assert lines[1].split() == ["family", "kind", "scale", "runs", "to", "run", "frames", "(at",
+                                "most)"]  # fmt: skip
+    assert lines[2].split() == ["cases", "case", "small", "1", "1", "60"]
+    assert lines[3].split() == ["tiny", "collision", "small", "1", "1", "6"]
+    # 6 frames at 256x144 and 60 at 768x432, each with the ablation, on 2 workers.
+    bench = (6 * (0.0456 / 9 + 0.0339 + 0.0217) + 60 * 0.1012) / 66
+    assert lines[4] == (
+        f"time: up to 3 s on 2 workers: up to 66 frames x {bench:.3f} s per frame and worker "
+        "(the simulator benchmark's 79.5/101.2 ms per 768x432 frame (bench/history.jsonl); "
+        "no run measured yet)"
+    )
+    assert not out.exists()  # a dry run writes nothing
+    # Finished runs in the results file replace the benchmark's figure by their own.
+    rows = [{"id": "x/1", "frames": 10, "timing": {"wall_s": 3.0}},
+            {"id": "x/2", "frames": 30, "timing": {"wall_s": 5.0}}]  # fmt: skip
+    out.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    assert main(["sweep", str(spec), "--out", str(out), "--dry-run", "--no-ablation"]) == 0
+    time_line = capsys.readouterr().out.splitlines()[4]
+    assert time_line.startswith("time: up to ") and time_line.endswith(
+        f"up to 66 frames x 0.200 s per frame and worker (measured on 2 finished runs in {out})"
+    )
+
+
+def test_a_sweep_reports_the_recordings_it_kept_and_leaves_no_empty_folders(
+    tmp_path: Path,
+) -> None:
+    from sim.commands.sweep import kept_recordings
+
+    folder = tmp_path / "r_rrd"
+    (folder / "cases").mkdir(parents=True)
+    (folder / "cpna-25" / "deeper").mkdir(parents=True)
+    (folder / "cpna-25" / "0001-ab.rrd").write_bytes(b"RRF2")
+    assert kept_recordings(folder, "failed") == (
+        f"recordings (missed collisions and false alarms): 1 in {folder}"
+    )
+    assert sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*")) == [
+        "cpna-25",
+        "cpna-25/0001-ab.rrd",
+    ]
+    (folder / "cpna-25" / "0001-ab.rrd").unlink()
+    assert kept_recordings(folder, "all") == "recordings (every run): none kept"
+    assert not folder.exists()
+    assert kept_recordings(folder, "failed").endswith("none kept")
