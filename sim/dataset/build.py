@@ -25,8 +25,9 @@ object, 2 in view; RLE masks), frames.csv (one row per image), runs.csv and READ
 (the card: what, how, counts, licence).
 
 Deterministic for a spec: the run seeds (the gait phase) are the sweep's, the renderer
-and the pose models are deterministic on one machine; only the measured-time columns of the features
-(…Ms) differ between invocations.
+and the pose models are deterministic on one machine; only measured times differ between
+invocations: the features' …Ms columns and each run record's `seconds` (which time
+estimates use).
 """
 
 from __future__ import annotations
