@@ -25,6 +25,7 @@ def run(args: argparse.Namespace) -> int:
     results: Path = args.results
     if not results.is_file():
         raise UserError(f"{results}: no such results file")
+    check_results_file(results)
     rows = list(read_results(results))
     if not rows:
         raise UserError(f"{results}: no finished runs in it yet")
@@ -35,3 +36,29 @@ def run(args: argparse.Namespace) -> int:
     print(f"\n{ran_on(metrics)}")
     print(f"report: {report.markdown} ({len(report.plots)} plots)")
     return 0
+
+
+def check_results_file(path: Path) -> None:
+    """UserError unless the file's first line is a sweep's result line (JSON with an id).
+
+    A CSV or any other file given by mistake is named as such here, rather than by the
+    results reader's advice for a bad line in a sweep's own file."""
+    import json
+
+    from monopic.errors import UserError
+
+    with path.open("rb") as fh:
+        first = fh.readline()
+    if not first.strip():
+        return  # empty: the caller says there are no runs yet
+    try:
+        row = json.loads(first)
+        ok = isinstance(row, dict) and isinstance(row.get("id"), str)
+    except ValueError:
+        ok = False
+    if not ok:
+        shown = first[:40].decode("utf-8", "replace").strip()
+        raise UserError(
+            f"{path}: not a sweep's results file (its first line, {shown!r}, is not a JSON "
+            "result line): give the .jsonl that `monopic sweep` writes"
+        )

@@ -187,3 +187,22 @@ def test_a_sweep_reports_the_recordings_it_kept_and_leaves_no_empty_folders(
     assert kept_recordings(folder, "all") == "recordings (every run): none kept"
     assert not folder.exists()
     assert kept_recordings(folder, "failed").endswith("none kept")
+
+
+def test_report_of_a_file_that_is_not_a_results_file_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    walk = tmp_path / "walk.csv"
+    walk.write_text("time,x\n1,2\n")
+    assert main(["report", str(walk)]) == 2
+    err = one_line_error(capsys)
+    assert err == (
+        f"monopic report: error: {walk}: not a sweep's results file (its first line, "
+        "'time,x', is not a JSON result line): give the .jsonl that `monopic sweep` writes"
+    )
+    assert "--out" not in err
+    assert not (tmp_path / "walk_report").exists()
+    empty = tmp_path / "empty.jsonl"
+    empty.write_text("")
+    assert main(["report", str(empty)]) == 2
+    assert one_line_error(capsys).endswith(f"{empty}: no finished runs in it yet")
