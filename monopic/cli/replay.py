@@ -36,7 +36,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("logs", nargs="+", type=Path, metavar="LOG.csv")
+    p.add_argument(
+        "logs", nargs="+", type=Path, metavar="LOG.csv", help="logs in the authors' CSV format"
+    )
     p.add_argument("--tree", type=Path, metavar="TREE.json", help="judge with this tree")
     p.add_argument(
         "--csv",

@@ -35,13 +35,21 @@ def register(sub: argparse._SubParsersAction) -> None:
         "per policy. Default scenarios: the small-robot Euro NCAP-style collision families "
         f"({', '.join(NCAP_FAMILIES)} in {FAMILY_FOLDER}) at each --speeds.",
     )
-    p.add_argument("files", nargs="*", type=Path, metavar="SCENARIO.toml")
+    p.add_argument(
+        "files",
+        nargs="*",
+        type=Path,
+        metavar="SCENARIO.toml",
+        help="scenario files, each run at every --speeds (default: the families above)",
+    )
     p.add_argument(
         "--cases",
         help="instead of files: place_case crossings on a collision course, e.g. 5,6 "
         f"(they meet the robot's front at {MEET_TIME:g} s unless it brakes)",
     )
-    p.add_argument("--speeds", default="1,2,3", help="robot speeds, m/s (default 1,2,3)")
+    p.add_argument(
+        "--speeds", default="1,2,3", help="robot speeds, m/s, comma-separated (default %(default)s)"
+    )
     p.add_argument(
         "--policies",
         default=DEFAULT_POLICIES,
@@ -54,7 +62,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         type=non_negative_float,
         help="apply this fixed latency instead of the measured one",
     )
-    p.add_argument("--seed", type=int, default=0, help="environment seed (gait phase)")
+    p.add_argument(
+        "--seed", type=int, default=0, help="environment seed: the gait phase (default %(default)d)"
+    )
     p.add_argument("--out", type=Path, help="write the tables (Markdown) here")
     p.add_argument("--rrd-dir", type=Path, help="record every braking run into this folder")
     p.set_defaults(func=run)
@@ -74,6 +84,7 @@ def case_scenarios(cases: str, speeds: list[float]) -> list[Scenario]:
     from monopic.cases import Case
     from sim.scenario.cases import CasePlacement
     from sim.scenario.families import PlacementError
+    from sim.scenario.files import street_problem
 
     out = []
     for text in cases.split(","):
@@ -97,7 +108,12 @@ def case_scenarios(cases: str, speeds: list[float]) -> list[Scenario]:
             except PlacementError as err:  # e.g. a robot speed beyond the placement's range
                 message = f"--speeds {v:g}: case {int(case)}: {err.field} {err.reason}"
                 raise UserError(message) from None
-            out.append(placement.scenario(name=f"case{int(case)}@{v:g}"))
+            scenario = placement.scenario(name=f"case{int(case)}@{v:g}")
+            problem = street_problem(scenario)  # as a scenario file with these values
+            if problem is not None:
+                message = f"--speeds {v:g}: case {int(case)}: {problem.field} {problem.reason}"
+                raise UserError(message)
+            out.append(scenario)
     return out
 
 

@@ -33,7 +33,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="SPEC.toml",
         help="a sweep spec: scenarios/datasets/*.toml, scenarios/sweeps/*.toml",
     )
-    p.add_argument("--out", type=Path, required=True, metavar="DIR")
+    p.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        metavar="DIR",
+        help="the dataset folder (made as needed; an unfinished one of the same spec resumes)",
+    )
     p.add_argument(
         "--estimate-only", action="store_true", help="print the size and time estimate and stop"
     )

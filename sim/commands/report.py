@@ -7,10 +7,20 @@ from pathlib import Path
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("report", help="write the Markdown report of a sweep's results file")
+    p = sub.add_parser(
+        "report",
+        help="write the Markdown report of a sweep's results file",
+        description="Read a sweep's results file and write report.md with its plots into a "
+        "folder: collision-warning recall and lead time per predictor and family, precision "
+        "and false alarms, near misses warned, case accuracy, position error, found share and "
+        "phi, each saying what it ran on (runs, seeds, frame size, machine, code). Prints the "
+        "headline table.",
+    )
     p.add_argument("results", type=Path, help="results file written by monopic sweep (.jsonl)")
     p.add_argument(
-        "--out", type=Path, help="report folder (default: beside RESULTS, <name>_report/)"
+        "--out",
+        type=Path,
+        help="report folder, made as needed (default: beside RESULTS, <name>_report/)",
     )
     p.set_defaults(func=run)
 

@@ -18,6 +18,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "sweep",
         help="run a scenario sweep (scenarios/sweeps/*.toml) and append results as JSON lines",
+        description="Expand a sweep spec into runs (scenario files and how to sample them, "
+        "scenarios/README.md), render each through every predictor in image and ground mode "
+        "(plus the ground-truth-crop ablation) on local workers or a Ray cluster, and append "
+        "one JSON line per finished run to the results file. Running it again with the same "
+        "--out resumes: runs already there (made by the same code) are skipped. --dry-run "
+        "shows the runs per family and the estimated time first.",
     )
     p.add_argument("spec", type=Path, help="sweep spec, e.g. scenarios/sweeps/demo.toml")
     p.add_argument(
@@ -26,7 +32,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--workers", type=positive_int, help="local worker processes (default: all cores)"
     )
-    p.add_argument("--executor", choices=("local", "ray"), default="local")
+    p.add_argument(
+        "--executor",
+        choices=("local", "ray"),
+        default="local",
+        help="local worker processes, or Ray tasks (extra `ray`) (default %(default)s)",
+    )
     p.add_argument("--address", help="Ray cluster address for --executor ray (e.g. host:6379)")
     p.add_argument(
         "--ablation",

@@ -538,16 +538,30 @@ def _parked_cars(
 
 def _check_on_street(path: Path, s: Scenario) -> None:
     """The robot stays on its road and the pedestrian on the street for the whole run."""
+    problem = street_problem(s)
+    if problem is not None:
+        raise ScenarioFileError(path, problem.field, problem.value, problem.reason)
+
+
+def street_problem(s: Scenario) -> PlacementError | None:
+    """Why the scenario leaves its street (robot off its road or past its end, pedestrian
+    off the street, robot faster than its own limit), None when it does not.
+
+    The whole-scenario checks of a scenario file, shared with scenarios made on the
+    command line (record, closed-loop --cases) so that both accept the same values."""
     road = s.scene.road
     y_right, y_left = road.edges
+    if s.robot.speed > s.robot.max_speed:
+        return PlacementError(
+            "robot.speed", s.robot.speed, f"must be <= {s.robot.max_speed:g} m/s (its max_speed)"
+        )
     if not (y_right <= -s.robot.width / 2 and s.robot.width / 2 <= y_left):
-        raise ScenarioFileError(
-            path, "scene.road.center_y", road.center_y, "the robot (at y = 0) is not on the road"
+        return PlacementError(
+            "scene.road.center_y", road.center_y, "the robot (at y = 0) is not on the road"
         )
     end = s.robot.speed * s.duration + s.robot.length / 2
     if end > road.length / 2:
-        raise ScenarioFileError(
-            path,
+        return PlacementError(
             "robot.speed",
             s.robot.speed,
             f"the robot would drive off the end of the road within the run "
@@ -559,10 +573,10 @@ def _check_on_street(path: Path, s: Scenario) -> None:
     for t in times:
         x, y = ped.state(t).position
         if not (x0 <= x <= x1 and y0 <= y <= y1):
-            raise ScenarioFileError(
-                path,
+            return PlacementError(
                 "path",
                 {"t": round(t, 3), "x": round(float(x), 2), "y": round(float(y), 2)},
                 f"the pedestrian's path leaves the street (x in [{x0:g}, {x1:g}] m, "
                 f"y in [{y0:.2f}, {y1:.2f}] m)",
             )
+    return None

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import tomllib
 from pathlib import Path
 
 import pytest
@@ -206,3 +207,40 @@ def test_report_of_a_file_that_is_not_a_results_file_says_so(
     empty.write_text("")
     assert main(["report", str(empty)]) == 2
     assert one_line_error(capsys).endswith(f"{empty}: no finished runs in it yet")
+
+
+@pytest.mark.parametrize(
+    ("option", "key", "value", "reason"),
+    [
+        ("--distance", "path.distance", -3.0, "must be >= 0 m"),
+        (
+            "--lateral-offset",
+            "path.lateral_offset",
+            40.0,
+            "the pedestrian's path leaves the street",
+        ),
+        ("--robot-speed", "robot.speed", 25.0, "must be <= 20 m/s"),
+        ("--duration", "duration", 0.0, "must be > 0 s"),
+    ],
+)
+def test_record_checks_a_case_as_a_scenario_file_checks_it(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    option: str,
+    key: str,
+    value: float,
+    reason: str,
+) -> None:
+    """The same value is refused on the command line and in a file, for the same reason."""
+    from sim.scenario.files import build, with_values
+    from sim.scenario.toml_table import FieldError
+
+    # Case 5 as a file, with the command's robot (RobotSpec's limits: 20 m/s).
+    text = CASE5.read_text().split("[sweep]")[0].replace("[robot]", "[robot]\nmax_speed = 20.0")
+    with pytest.raises(FieldError) as in_file:
+        build(CASE5, with_values(tomllib.loads(text), {key: value}))
+    assert reason in in_file.value.reason
+    assert main(["record", "5", option, str(value), "--rrd", str(tmp_path / "x.rrd")]) == 2
+    err = one_line_error(capsys)
+    assert f"{option} {value:g}" in err and reason in err
+    assert not (tmp_path / "x.rrd").exists()
