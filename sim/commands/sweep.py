@@ -3,7 +3,10 @@
 from __future__ import annotations
 
 import argparse
+import logging
 import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -89,16 +92,17 @@ def run(args: argparse.Namespace) -> int:
         executor = ray_executor(args.address)
     else:
         executor = local_executor(args.workers)
-    outcome = run_sweep(
-        spec,
-        out,
-        executor,
-        ablation=args.ablation,
-        limit=args.limit,
-        record=args.record,
-        record_dir=args.recordings,
-        restart=args.restart,
-    )
+    with logs_above_the_bar(args.executor):
+        outcome = run_sweep(
+            spec,
+            out,
+            executor,
+            ablation=args.ablation,
+            limit=args.limit,
+            record=args.record,
+            record_dir=args.recordings,
+            restart=args.restart,
+        )
     rate = outcome.finished / outcome.seconds if outcome.seconds > 0 else 0.0
     print(
         f"{outcome.finished} runs finished in {outcome.seconds:.0f} s "
@@ -111,6 +115,27 @@ def run(args: argparse.Namespace) -> int:
     for run_id, error in outcome.failed[:3]:
         print(f"failed {run_id}:\n{error}")
     return 1 if outcome.failed else 0
+
+
+@contextmanager
+def logs_above_the_bar(executor: str) -> Iterator[None]:
+    """Ray's log lines (its start, the code upload, its warnings) written above the sweep's
+    progress bar through tqdm, instead of into the bar's line.
+
+    Ray logs through the 'ray' logger's own stderr handler, set up when ray is imported;
+    Ray is imported here so that handler exists to be redirected for the sweep."""
+    if executor != "ray":
+        yield
+        return
+    try:
+        import ray  # noqa: F401
+    except ImportError:  # the executor says how to install it
+        yield
+        return
+    from tqdm.contrib.logging import logging_redirect_tqdm
+
+    with logging_redirect_tqdm(loggers=[logging.getLogger("ray")]):
+        yield
 
 
 def kept_recordings(folder: Path, record: str) -> str:

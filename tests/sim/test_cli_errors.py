@@ -244,3 +244,29 @@ def test_record_checks_a_case_as_a_scenario_file_checks_it(
     err = one_line_error(capsys)
     assert f"{option} {value:g}" in err and reason in err
     assert not (tmp_path / "x.rrd").exists()
+
+
+def test_ray_log_lines_go_above_the_progress_bar_not_into_it(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Ray logs its start and code upload through the 'ray' logger while the sweep's bar is
+    drawn; inside the sweep they are written by tqdm, which clears the bar line first."""
+    import logging
+
+    from tqdm import tqdm
+
+    from sim.commands.sweep import logs_above_the_bar
+
+    pytest.importorskip("ray")
+    ray_logger = logging.getLogger("ray")
+    before = list(ray_logger.handlers)
+    with logs_above_the_bar("ray"), tqdm(total=2, desc="sweep", ncols=60) as bar:
+        bar.update(1)
+        logging.getLogger("ray._private.worker").warning("Started a local Ray instance.")
+        bar.update(1)
+    assert ray_logger.handlers == before  # restored after the sweep
+    err = capsys.readouterr().err
+    (logged,) = [seg for seg in err.split("\r") if "Started a local" in seg]
+    # tqdm.write: the bar's line cleared, the message on a line of its own, the bar redrawn
+    # after it; without the redirect the message is glued to the bar's text ("| 1/2 [...]").
+    assert logged.endswith("-- Started a local Ray instance.\n") and "|" not in logged, err
