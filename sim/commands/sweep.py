@@ -159,7 +159,7 @@ def kept_recordings(folder: Path, record: str) -> str:
 def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
     """Runs per family, what the results file already holds and the estimated time."""
     from sim.runs.code_version import code_version
-    from sim.runs.estimate import bench_frame_seconds, estimate_time
+    from sim.runs.estimate import SWEEP_START_S, bench_frame_seconds, estimate_time
     from sim.runs.results_file import read_rows, scan
     from sim.runs.sweep import expand_spec
 
@@ -203,6 +203,7 @@ def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
         measured,
         workers,
         f"in {out}",
+        SWEEP_START_S,
     )  # fmt: skip
     print(f"time: {time.text()}")
     other = state.other_code(code_version()) if state else None

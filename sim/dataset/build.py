@@ -57,7 +57,12 @@ from monopic.predict.rules import RulePredictor
 from sim.dataset.card import readme
 from sim.dataset.coco import SKELETONS, category, encode_mask, mask_box, select_keypoints
 from sim.dataset.spec import FORMAT_VERSION, JPEG_QUALITY, DatasetRun, DatasetSpec, expand
-from sim.runs.estimate import TimeEstimate, bench_frame_seconds, estimate_time
+from sim.runs.estimate import (
+    DATASET_START_S,
+    TimeEstimate,
+    bench_frame_seconds,
+    estimate_time,
+)
 from sim.runs.loop import Listener, LoopFrame, OnBoard, Progress, run_loop
 from sim.runs.sweep import SweepSpec
 from sim.scenario.spec import CameraSpec, Scenario
@@ -296,6 +301,7 @@ def estimate_duration(todo: list[DatasetRun], finished: list[dict[str, Any]]) ->
         [(r["frames"], r.get("seconds", 0.0)) for r in finished],
         workers=1,
         measured_where="of this dataset",
+        start_seconds=DATASET_START_S,
     )
 
 

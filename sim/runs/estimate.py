@@ -12,7 +12,9 @@ files too) measured the same as a sweep frame without the ablation (90 ms agains
 at 768x432 on one core, 2026-12-01), so datasets use that figure. Frames are an upper
 bound: a run ends early at first contact, so collision runs take less. Another machine,
 or a loaded one, differs: the measured figure replaces the benchmark's as soon as one run
-has finished.
+has finished. Starting costs a fixed time on top, which dominates tiny sweeps: a sweep
+spent 8 s before its first run began (spawning workers that import MuJoCo, onnxruntime
+and the pipeline), a dataset 3 s around its runs (2026-12-01, 2 cores under load 4-5).
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ BENCH_RENDER_S = 0.0456  # MuJoCo render of one 768x432 frame (llvmpipe), one co
 BENCH_PIPELINE_S = 0.0795 - BENCH_RENDER_S  # pose, features, five predictors, truth
 BENCH_ABLATION_S = 0.1012 - 0.0795  # the ground-truth-crop pipeline on the same frame
 BENCH_SOURCE = "the simulator benchmark's 79.5/101.2 ms per 768x432 frame (bench/history.jsonl)"
+SWEEP_START_S = 8.0  # from the command's start to its workers' first runs (measured)
+DATASET_START_S = 3.0  # a dataset's imports, GL context and merge (measured)
 
 
 def bench_frame_seconds(camera: CameraSpec, ablation: bool) -> float:
@@ -44,6 +48,7 @@ class TimeEstimate:
     frame_seconds: float  # one worker, per frame (mean over the runs)
     workers: int | None  # None: unknown (a Ray cluster's CPUs)
     source: str  # where frame_seconds comes from
+    start_seconds: float = 0.0  # before the first run (workers starting)
 
     @property
     def worker_seconds(self) -> float:
@@ -53,7 +58,7 @@ class TimeEstimate:
     def seconds(self) -> float | None:
         if self.workers is None:
             return None
-        return self.worker_seconds / max(1, min(self.workers, self.runs))
+        return self.start_seconds + self.worker_seconds / max(1, min(self.workers, self.runs))
 
     def text(self) -> str:
         """One line: the figure and how it was computed."""
@@ -66,7 +71,8 @@ class TimeEstimate:
         if self.seconds is None:
             return f"up to {_duration(self.worker_seconds)} of CPU time, over the cluster: {how}"
         used = max(1, min(self.workers or 1, self.runs))
-        return f"up to {_duration(self.seconds)} on {used} worker{'s' * (used > 1)}: {how}"
+        start = f"{self.start_seconds:.0f} s to start, then " if self.start_seconds else ""
+        return f"up to {_duration(self.seconds)} on {used} worker{'s' * (used > 1)}: {start}{how}"
 
 
 def _duration(seconds: float) -> str:
@@ -82,6 +88,7 @@ def estimate_time(
     measured: Iterable[tuple[int, float]],
     workers: int | None,
     measured_where: str,
+    start_seconds: float = 0.0,
 ) -> TimeEstimate:
     """The time of runs given as (frames, benchmark seconds per frame).
 
@@ -96,4 +103,4 @@ def estimate_time(
     else:
         per = sum(f * s for f, s in todo) / frames if frames else 0.0
         source = BENCH_SOURCE + "; no run measured yet"
-    return TimeEstimate(len(todo), frames, per, workers, source)
+    return TimeEstimate(len(todo), frames, per, workers, source, start_seconds)
