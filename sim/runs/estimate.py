@@ -69,10 +69,10 @@ class TimeEstimate:
             f"({self.source})"
         )
         if self.seconds is None:
-            return f"up to {_duration(self.worker_seconds)} of CPU time, over the cluster: {how}"
+            return f"about {_duration(self.worker_seconds)} of CPU time, over the cluster: {how}"
         used = max(1, min(self.workers or 1, self.runs))
         start = f"{self.start_seconds:.0f} s to start, then " if self.start_seconds else ""
-        return f"up to {_duration(self.seconds)} on {used} worker{'s' * (used > 1)}: {start}{how}"
+        return f"about {_duration(self.seconds)} on {used} worker{'s' * (used > 1)}: {start}{how}"
 
 
 def _duration(seconds: float) -> str:

@@ -152,7 +152,7 @@ def test_dry_run_shows_runs_per_family_and_a_time_it_says_how_it_computed(
     # 6 frames at 256x144 and 60 at 768x432, each with the ablation, on 2 workers.
     bench = (6 * (0.0456 / 9 + 0.0339 + 0.0217) + 60 * 0.1012) / 66
     assert lines[4] == (
-        f"time: up to 11 s on 2 workers: 8 s to start, then up to 66 frames x {bench:.3f} s "
+        f"time: about 11 s on 2 workers: 8 s to start, then up to 66 frames x {bench:.3f} s "
         "per frame and worker "
         "(the simulator benchmark's 79.5/101.2 ms per 768x432 frame (bench/history.jsonl); "
         "no run measured yet)"
@@ -164,7 +164,7 @@ def test_dry_run_shows_runs_per_family_and_a_time_it_says_how_it_computed(
     out.write_text("".join(json.dumps(r) + "\n" for r in rows))
     assert main(["sweep", str(spec), "--out", str(out), "--dry-run", "--no-ablation"]) == 0
     time_line = capsys.readouterr().out.splitlines()[4]
-    assert time_line.startswith("time: up to ") and time_line.endswith(
+    assert time_line.startswith("time: about ") and time_line.endswith(
         f"up to 66 frames x 0.200 s per frame and worker (measured on 2 finished runs in {out})"
     )
 
