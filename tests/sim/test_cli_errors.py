@@ -93,9 +93,9 @@ def test_base_sampling_applies_its_parameters_and_refuses_draw_settings(tmp_path
 def test_every_command_makes_the_folder_its_output_goes_to(
     tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    """One rule for output paths (README): a missing folder is created, for tree, replay
-    and report here; video, record, sweep and closed-loop are run so in their own tests
-    and in the README walkthrough (tests/test_walkthrough.py)."""
+    """One rule for output paths (README): a missing folder is created, for tree and replay
+    here; video (test_cli_video_errors), sweep and report (test_sweep), closed-loop and
+    dataset (below) and record (tests/test_walkthrough.py) in their own tests."""
     from tests.paths import DATA
 
     logs = sorted((DATA / "authors").glob("data*.csv"))
@@ -271,3 +271,25 @@ def test_ray_log_lines_go_above_the_progress_bar_not_into_it(
     # tqdm.write: the bar's line cleared, the message on a line of its own, the bar redrawn
     # after it; without the redirect the message is glued to the bar's text ("| 1/2 [...]").
     assert logged.endswith("-- Started a local Ray instance.\n") and "|" not in logged, err
+
+
+@pytest.mark.slow
+def test_closed_loop_and_dataset_make_their_output_folders(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The output rule for the two commands the walkthrough runs without --out."""
+    scenario = tmp_path / "tiny.toml"
+    scenario.write_text(TINY.split("[sweep]")[0])
+    table = tmp_path / "a" / "b" / "table.md"
+    rrd_dir = tmp_path / "c" / "rrd"
+    argv = ["closed-loop", str(scenario), "--speeds", "1", "--policies", "none,truth"]
+    assert main([*argv, "--out", str(table), "--rrd-dir", str(rrd_dir)]) == 0
+    assert table.read_text().startswith("# Closed loop") and rrd_dir.is_dir()
+    spec = tmp_path / "spec.toml"
+    spec.write_text('name = "t"\n[[include]]\nfiles = ["tiny.toml"]\nsampling = "base"\n')
+    out = tmp_path / "d" / "e" / "dataset"
+    capsys.readouterr()
+    assert main(["dataset", str(spec), "--out", str(out)]) == 0
+    assert (out / "README.md").is_file() and (out / "runs").is_dir()
+    printed = capsys.readouterr().out
+    assert "time: about 3 s on 1 worker: 3 s to start, then up to 6 frames x " in printed
