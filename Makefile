@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 export MUJOCO_GL ?= egl
 
-.PHONY: install demo test lint format clean-venv
+.PHONY: install demo test lint format clean-venv realism
 
 install: $(STAMP)
 
@@ -35,6 +35,15 @@ lint: $(STAMP)
 format: $(STAMP)
 	$(BIN)/ruff format .
 	$(BIN)/ruff check --fix .
+
+# Simulated walkers beside real ones (docs/realism/report.md): free walks and the medium
+# sweep's families, human and rail, against the ETH/UCY scenes shipped beside the project
+# (read at run time, never copied in). A minute or two.
+REAL_TRACKS ?= ../shared/data/eth-ucy-calibration
+realism: $(STAMP)
+	$(BIN)/monopic realism scenarios/sweeps/walks.toml scenarios/sweeps/walks-rail.toml \
+		scenarios/sweeps/medium-human.toml scenarios/sweeps/medium.toml \
+		--real $(REAL_TRACKS)/*.txt --out docs/realism --judge walks
 
 clean-venv:
 	rm -rf $(VENV)

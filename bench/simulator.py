@@ -36,17 +36,22 @@ RUN_CASES = (5, 3, 5, 3)  # the whole-run rows: two cases twice, so one noisy ru
 TITLE = "Simulator: render time, scenario run on one core, sweep throughput"
 
 
-def scenario(case: int, frames: int, seed: int = 0, shadows: bool = True) -> Any:
+def scenario(
+    case: int, frames: int, seed: int = 0, shadows: bool = True, model: str = "rail"
+) -> Any:
     """A case at the default 8 m with the robot driving at 2 m/s, `frames` frames at 15 fps.
 
-    `shadows=False` is the overcast lighting (no shadow pass in the render).
+    `shadows=False` is the overcast lighting (no shadow pass in the render); `model` the
+    pedestrian's behaviour (a human walker's truth has a Track piece every 10 ms).
     """
     from dataclasses import replace
 
     from monopic.cases import Case
     from sim.scenario.cases import CasePlacement
+    from sim.scenario.spec import Behaviour
 
-    sc = CasePlacement(Case(case), duration=frames / REALTIME_FPS, seed=seed).scenario()
+    placement = CasePlacement(Case(case), duration=frames / REALTIME_FPS, seed=seed)
+    sc = placement.scenario(behaviour=Behaviour(model=model))
     return replace(sc, scene=replace(sc.scene, shadows=shadows))
 
 
@@ -58,12 +63,14 @@ def child_render(frames: int) -> dict[str, Any]:
     from sim.world.world import World
 
     out: dict[str, Any] = {}
-    for render in (False, True, False, True):  # alternated, the second pair kept
-        sc = scenario(5, frames)
-        times = StepTimes()
-        with World(sc, render=render) as world:
-            run_loop(world, (), [times], frames=frames, stop_at_contact=False)
-        out["render" if render else "no_render"] = times.ms[1:]  # steps, not the reset
+    for model in ("rail", "human", "rail", "human"):  # alternated, the second pair kept
+        for render in (False, True):
+            sc = scenario(5, frames, model=model)
+            times = StepTimes()
+            with World(sc, render=render) as world:
+                run_loop(world, (), [times], frames=frames, stop_at_contact=False)
+            key = ("render" if render else "no_render") + ("_human" if model == "human" else "")
+            out[key] = times.ms[1:]  # steps, not the reset
     res = {}
     for k, v in out.items():
         a = np.array(v[2:])
@@ -72,7 +79,9 @@ def child_render(frames: int) -> dict[str, Any]:
     return res
 
 
-def child_run(frames: int, ablation: bool, shadows: bool = True) -> dict[str, Any]:
+def child_run(
+    frames: int, ablation: bool, shadows: bool = True, model: str = "rail"
+) -> dict[str, Any]:
     """One whole scenario through sim.runs.runner.run, after one warm-up run; frames per second.
 
     As in a sweep worker, the runs share one GL context (sim.world.render.KeptRenderContext), so
@@ -89,7 +98,7 @@ def child_run(frames: int, ablation: bool, shadows: bool = True) -> dict[str, An
         run(warm, render_context=context)
         for case in RUN_CASES:
             spec = RunSpec(
-                id=f"case{case}", scenario=scenario(case, frames, shadows=shadows),
+                id=f"case{case}", scenario=scenario(case, frames, shadows=shadows, model=model),
                 ablation=ablation, stop_at_contact=False,
             )  # fmt: skip
             cpu0, t0 = time.process_time(), time.perf_counter()
@@ -157,6 +166,7 @@ def main() -> None:
     ap.add_argument("--ablation", type=int, default=0, help=argparse.SUPPRESS)
     ap.add_argument("--shadows", type=int, default=1, help=argparse.SUPPRESS)
     ap.add_argument("--workers", type=int, default=1, help=argparse.SUPPRESS)
+    ap.add_argument("--model", default="rail", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
         if args.pin:
@@ -164,7 +174,7 @@ def main() -> None:
         if args.child == "render":
             out = child_render(args.frames)
         elif args.child == "run":
-            out = child_run(args.frames, bool(args.ablation), bool(args.shadows))
+            out = child_run(args.frames, bool(args.ablation), bool(args.shadows), args.model)
         else:
             out = child_sweep(args.frames, args.runs, args.workers)
         print(json.dumps(out))
@@ -175,8 +185,10 @@ def main() -> None:
     start = time.perf_counter()
     render = spawn_child("render", True, frames=args.frames)
     runs = {
-        (ab, sh): spawn_child("run", True, frames=args.frames, ablation=ab, shadows=sh)
-        for ab, sh in ((0, 1), (1, 1), (0, 0))
+        (ab, sh, model): spawn_child(
+            "run", True, frames=args.frames, ablation=ab, shadows=sh, model=model
+        )
+        for ab, sh, model in ((0, 1, "rail"), (0, 1, "human"), (1, 1, "rail"), (0, 0, "rail"))
     }
     sweeps = {
         w: spawn_child("sweep", False, frames=args.frames, runs=args.runs, workers=w)
@@ -184,6 +196,7 @@ def main() -> None:
     }
     load1 = os.getloadavg()[0]
     r, nr = render["render"], render["no_render"]
+    rh, nrh = render["render_human"], render["no_render_human"]
     lines = [
         f"Scenarios: sim.scenario.cases.CasePlacement, 8 m, robot 2 m/s, {args.frames} frames "
         f"at 15 fps, 768x432; child processes with sim.runs.executors.WORKER_ENV; load average "
@@ -195,6 +208,9 @@ def main() -> None:
         f"| with rendering (768x432) | {r['p50']:.1f} ms | {r['p95']:.1f} ms |",
         f"| without rendering (truth only) | {nr['p50']:.1f} ms | {nr['p95']:.1f} ms |",
         f"| render alone (difference of p50) | {r['p50'] - nr['p50']:.1f} ms | |",
+        f"| with rendering, human walker | {rh['p50']:.1f} ms | {rh['p95']:.1f} ms |",
+        f"| without rendering, human walker (truth only) | {nrh['p50']:.1f} ms "
+        f"| {nrh['p95']:.1f} ms |",
         "",
         "| whole scenario run on one core (sim.runs.runner.run, GL context kept) | frames "
         "| fps (median of 4 runs) "
@@ -210,21 +226,27 @@ def main() -> None:
             "no_render_p50_ms": nr["p50"],
             "no_render_p95_ms": nr["p95"],
             "render_alone_p50_ms": r["p50"] - nr["p50"],
+            "human_render_p50_ms": rh["p50"],
+            "human_render_p95_ms": rh["p95"],
+            "human_no_render_p50_ms": nrh["p50"],
+            "human_no_render_p95_ms": nrh["p95"],
         },
         "scenario_runs": [],
         "sweeps": [],
     }
-    for (ab, sh), res in runs.items():
+    for (ab, sh, model), res in runs.items():
         fps = sorted(x["frames"] / x["wall_s"] for x in res["runs"])
         med = statistics.median(fps)
         cpu = sum(x["cpu_s"] for x in res["runs"]) / sum(x["frames"] for x in res["runs"])
         name = "render + pipeline (5 predictors)" + (" + ground-truth-crop ablation" if ab else "")
         name += "" if sh else ", overcast (no shadow pass)"
+        name += ", human walker" if model == "human" else ""
         results["scenario_runs"].append(
             {
                 "name": name,
                 "ablation": bool(ab),
                 "shadows": bool(sh),
+                "behaviour": model,
                 "frames": res["runs"][0]["frames"],
                 "runs": len(fps),
                 "fps_median": med,

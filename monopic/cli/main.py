@@ -71,24 +71,33 @@ def _terminate(signum: int, frame: object) -> None:
 
 
 def main(argv: Sequence[str] | None = None) -> int:
-    try:
-        parser = build_parser()
-    except UserError as err:
-        print(f"monopic: error: {err}", file=sys.stderr)
-        return 2
-    args = parser.parse_args(argv)
+    """Run one sub-command; every way it ends is one line and an exit code.
+
+    0 done, 1 the command's own failure (e.g. failed runs), 2 bad input (UserError),
+    130 interrupted (SIGINT, Ctrl-C), 143 terminated (SIGTERM). The SIGTERM handler goes
+    in first, so a stop while the commands load is answered like one mid-run.
+    """
     in_main_thread = threading.current_thread() is threading.main_thread()
     previous = signal.signal(signal.SIGTERM, _terminate) if in_main_thread else None
+    command = "monopic"
     try:
-        return int(args.func(args) or 0)
-    except UserError as err:
-        print(f"monopic {args.command}: error: {err}", file=sys.stderr)
-        return 2
+        try:
+            parser = build_parser()
+        except UserError as err:
+            print(f"monopic: error: {err}", file=sys.stderr)
+            return 2
+        args = parser.parse_args(argv)
+        command = f"monopic {args.command}"
+        try:
+            return int(args.func(args) or 0)
+        except UserError as err:
+            print(f"{command}: error: {err}", file=sys.stderr)
+            return 2
     except KeyboardInterrupt:
-        print(f"monopic {args.command}: interrupted", file=sys.stderr)
+        print(f"{command}: interrupted", file=sys.stderr)
         return 130
     except Terminated:
-        print(f"monopic {args.command}: terminated", file=sys.stderr)
+        print(f"{command}: terminated", file=sys.stderr)
         return 143
     finally:
         if in_main_thread:

@@ -3,9 +3,12 @@
 Format (shared/data/authors-testdata/README.md): a header line, then one row per
 processed frame with the columns in COLUMNS (extra columns are allowed and ignored).
 Every cell of those columns must be a finite number, time must increase from row to row,
-occupiedHeights must be positive, and a log needs at least MIN_ROWS rows. Anything else is
-a UserError naming the file, the line (1-based line of the file; the header is line 1)
-and the column.
+occupiedHeights must be positive, and a log needs at least MIN_ROWS rows. Values no
+camera or clock produces are rejected too: image coordinates beyond +-MAX_IMAGE_PX, a
+window or a horizon of 0 or below, a frame rate below 0 (0 only on the first row, which
+the authors' logs use for "no rate yet") and times outside [0, MAX_TIME_S]. Anything
+else is a UserError naming the file, the line (1-based line of the file; the header is
+line 1) and the column.
 """
 
 from __future__ import annotations
@@ -41,6 +44,21 @@ COLUMNS = (
     "predictedY",
 )
 MIN_ROWS = 2
+# Far outside any frame (a 768x432 log's own predictions reach -400 and 1400 px).
+MAX_IMAGE_PX = 1e5
+PIXEL_COLUMNS = (
+    "currentCenterX",
+    "currentCenterY",
+    "leftShoulderX",
+    "leftShoulderY",
+    "rightShoulderX",
+    "rightShoulderY",
+    "predictedX",
+    "predictedY",
+)
+# Seconds: Unix time until the year 2286, or over 300 years of video; a log in
+# milliseconds is beyond it too.
+MAX_TIME_S = 1e10
 # occupiedHeights is the landmarks' vertical extent divided by the 432 px frame height.
 FRAME_HEIGHT_PX = 432.0
 
@@ -101,6 +119,7 @@ def read_log(path: Path) -> AuthorsLog:
             raise UserError(
                 f"{path}: line {line}: {len(cells)} cells, the header has {len(header)}"
             )
+        first = not values["time"]  # the log's first data row
         for c in COLUMNS:
             cell = cells[index[c]].strip()
             try:
@@ -111,6 +130,9 @@ def read_log(path: Path) -> AuthorsLog:
                 ) from None
             if not math.isfinite(v):
                 raise UserError(f"{path}: line {line}, column {c!r}: {cell!r} is not finite")
+            impossible = _impossible(c, v, first)
+            if impossible:
+                raise UserError(f"{path}: line {line}, column {c!r}: {cell!r} {impossible}")
             values[c].append(v)
         t = values["time"]
         if len(t) >= 2 and t[-1] <= t[-2]:
@@ -141,3 +163,21 @@ def read_log(path: Path) -> AuthorsLog:
         predicted_x=arr["predictedX"],
         predicted_y=arr["predictedY"],
     )
+
+
+def _impossible(column: str, value: float, first: bool) -> str:
+    """Why a finite cell is a value no camera, walker or clock produces ("" if it is not).
+
+    `first`: the cell is on the log's first data row.
+    """
+    if column in PIXEL_COLUMNS and abs(value) > MAX_IMAGE_PX:
+        return f"is outside any image (beyond +-{MAX_IMAGE_PX:.0f} px)"
+    if column == "windowSize" and value <= 0:
+        return "is not a window (frames between velocity samples, > 0)"
+    if column == "fps" and (value < 0 or (value == 0 and not first)):
+        return "is not a frame rate (> 0 frames/s; 0 only on the first row)"
+    if column == "timeToFuture" and not 0 < value <= MAX_TIME_S:
+        return f"is not a horizon (seconds in (0, {MAX_TIME_S:.0e}])"
+    if column == "time" and not 0 <= value <= MAX_TIME_S:
+        return f"is beyond any clock (seconds in [0, {MAX_TIME_S:.0e}])"
+    return ""

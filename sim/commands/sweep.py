@@ -160,6 +160,7 @@ def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
     """Runs per family, what the results file already holds and the estimated time."""
     from sim.runs.code_version import code_version
     from sim.runs.estimate import SWEEP_START_S, bench_frame_seconds, estimate_time
+    from sim.runs.result import SCHEMA
     from sim.runs.results_file import read_rows, scan
     from sim.runs.sweep import expand_spec
 
@@ -210,3 +211,7 @@ def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
     if other:
         print(f"{out}: {sum(other.values())} of its runs were made by other code "
               "(a sweep would stop; --restart sets them aside)")  # fmt: skip
+    newer = state.newer_schema(SCHEMA) if state else None
+    if newer:
+        print(f"{out}:{newer[0]}: results of schema {newer[1]}, newer than this code's "
+              f"{SCHEMA} (a sweep would stop; --restart sets them aside)")  # fmt: skip

@@ -3,11 +3,15 @@
 Each line is written whole with one write, flushed and fsynced, so a sweep stopped at
 any moment (Ctrl-C, a crash, a lost machine) leaves every finished run on disk and at
 worst one torn last line. Resuming reads the ids already present, cuts a torn tail off
-and appends the rest: nothing is lost and nothing is run twice.
+and appends the rest: nothing is lost and nothing is run twice. A line that cannot be
+written whole (no space left, a quota, an I/O error) is cut off again before the error
+is reported, so the file always ends with a complete line.
 """
 
 from __future__ import annotations
 
+import contextlib
+import errno
 import fcntl
 import json
 import os
@@ -31,10 +35,20 @@ class ResultsState:
     good_bytes: int  # length of the prefix made of complete lines
     torn: bool  # a partial last line follows the good prefix
     codes: Counter[str] = field(default_factory=Counter)  # lines per code version
+    # The first line (1-based) holding each result schema (sim.runs.runner.SCHEMA).
+    schemas: dict[int, int] = field(default_factory=dict)
 
     def other_code(self, code: str) -> Counter[str]:
         """Lines made by code other than `code`, per code version."""
         return Counter({c: n for c, n in self.codes.items() if c != code})
+
+    def newer_schema(self, schema: int) -> tuple[int, int] | None:
+        """(line, schema) of the first line of a schema newer than `schema`, if any.
+
+        Such lines were written by newer code: this code would misread them.
+        """
+        newer = sorted((line, s) for s, line in self.schemas.items() if s > schema)
+        return newer[0] if newer else None
 
 
 def scan(path: Path) -> ResultsState:
@@ -47,6 +61,7 @@ def scan(path: Path) -> ResultsState:
         return ResultsState(frozenset(), 0, False)
     ids: set[str] = set()
     codes: Counter[str] = Counter()
+    schemas: dict[int, int] = {}
     good = 0
     *complete, tail = path.read_bytes().split(b"\n")
     for number, raw in enumerate(complete, start=1):
@@ -61,9 +76,12 @@ def scan(path: Path) -> ResultsState:
             ) from None
         ids.add(run_id)
         codes[str(row.get("code") or UNKNOWN)] += 1
+        schema = row.get("schema")
+        if isinstance(schema, int) and not isinstance(schema, bool):
+            schemas.setdefault(schema, number)
         good += len(raw) + 1
     # Lines are written whole, newline included: an unterminated tail is a torn write.
-    return ResultsState(frozenset(ids), good, bool(tail), codes)
+    return ResultsState(frozenset(ids), good, bool(tail), codes, schemas)
 
 
 def read_rows(path: Path) -> Iterator[dict[str, Any]]:
@@ -91,23 +109,51 @@ class ResultsWriter(Closing):
 
     def __init__(self, path: Path) -> None:
         self.path = path
-        self._fh = path.open("ab")
         try:
-            fcntl.flock(self._fh.fileno(), fcntl.LOCK_EX | fcntl.LOCK_NB)
+            self._fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+        except OSError as err:
+            raise UserError(
+                f"{path}: cannot write there ({err.strerror or err}); use another --out"
+            ) from None
+        try:
+            fcntl.flock(self._fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
-            self._fh.close()
+            os.close(self._fd)
             raise UserError(
                 f"{path}: another sweep is writing to it; wait for it or use another --out"
             ) from None
-        self.state = scan(path)
+        try:
+            self.state = scan(path)
+        except BaseException:
+            os.close(self._fd)
+            raise
+        self._size = self.state.good_bytes
+        self.written = 0  # lines appended by this writer
         if self.state.torn:
-            self._fh.truncate(self.state.good_bytes)
+            os.ftruncate(self._fd, self._size)
 
     def append(self, row: dict[str, Any]) -> None:
+        """One line, whole and on disk; if it cannot be, the file is left as it was."""
         line = json.dumps(row, separators=(",", ":"), allow_nan=False).encode() + b"\n"
-        self._fh.write(line)
-        self._fh.flush()
-        os.fsync(self._fh.fileno())
+        try:
+            view = memoryview(line)
+            while view:
+                view = view[os.write(self._fd, view) :]
+            os.fsync(self._fd)
+        except OSError as err:
+            with contextlib.suppress(OSError):  # else resuming cuts the torn tail off
+                os.ftruncate(self._fd, self._size)
+            full = err.errno in (errno.ENOSPC, errno.EDQUOT)
+            raise UserError(
+                f"{self.path}: cannot append run {row.get('id')} ({err.strerror or err}); "
+                f"the {len(self.state.ids) + self.written} runs before it are intact: "
+                f"{'free some space' if full else 'fix that'} and run the sweep again to "
+                "resume"
+            ) from None
+        self._size += len(line)
+        self.written += 1
 
     def close(self) -> None:
-        self._fh.close()
+        if self._fd >= 0:
+            os.close(self._fd)
+            self._fd = -1

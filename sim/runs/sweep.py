@@ -34,6 +34,7 @@ from tqdm import tqdm
 
 from monopic.errors import UserError
 from sim.runs.code_version import code_version
+from sim.runs.result import SCHEMA
 from sim.runs.results_file import ResultsWriter, scan
 from sim.runs.run_spec import RunSpec
 from sim.scenario.files import (
@@ -231,7 +232,10 @@ def set_aside(out: Path, folder: Path, tag: str) -> None:
         if target.exists():
             raise UserError(f"{target}: already there; move it away to restart {out}")
     for source, target in moves:
-        source.rename(target)
+        try:
+            source.rename(target)
+        except OSError as err:
+            raise UserError(f"{source}: cannot set it aside ({err.strerror or err})") from None
         print(f"set aside: {source} -> {target}", file=sys.stderr)
 
 
@@ -262,17 +266,35 @@ def run_sweep(
     runs = [replace(r, record=record, record_dir=str(folder), code=code) for r in runs]
     if not out.parent.is_dir():
         raise UserError(f"{out}: its folder {out.parent} does not exist")
-    other = scan(out).other_code(code) if out.exists() else None
-    if other:
-        if not restart:
-            versions = ", ".join(f"{n} by {c}" for c, n in other.most_common())
-            raise UserError(
-                f"{out}: holds runs of other code ({versions}; this code is {code}), and a "
-                "sweep resumes only its own code's runs; use another --out, or --restart to "
-                "set the old results aside and start over"
-            )
-        set_aside(out, folder, other.most_common(1)[0][0] if len(other) == 1 else "mixed")
+    state = scan(out) if out.exists() else None
+    other = state.other_code(code) if state else None
+    newer = state.newer_schema(SCHEMA) if state else None
+    if newer and not restart:
+        line, schema = newer
+        raise UserError(
+            f"{out}:{line}: a result of schema {schema}, newer than this code's {SCHEMA} "
+            "(written by newer code, which alone reads it); to redo its runs with this code, "
+            "use another --out, or --restart to set the file aside and start over"
+        )
+    if other and not restart:
+        versions = ", ".join(f"{n} by {c}" for c, n in other.most_common())
+        raise UserError(
+            f"{out}: holds runs of other code ({versions}; this code is {code}), and a "
+            "sweep resumes only its own code's runs; use another --out, or --restart to "
+            "set the old results aside and start over"
+        )
+    if other or newer:
+        tag = other.most_common(1)[0][0] if other and len(other) == 1 else "mixed"
+        set_aside(out, folder, tag if other else f"schema{newer[1]}")
     with ResultsWriter(out) as writer:
+        if record != "none":
+            try:
+                folder.mkdir(parents=True, exist_ok=True)
+            except OSError as err:
+                raise UserError(
+                    f"{folder}: cannot make the recordings folder ({err.strerror or err}); "
+                    "use --recordings DIR or --record none"
+                ) from None
         state = writer.state
         todo = [r for r in runs if r.id not in state.ids]
         skipped = len(runs) - len(todo)

@@ -21,6 +21,8 @@ from dataclasses import dataclass, replace
 from enum import StrEnum
 
 from sim.scenario.spec import (
+    Anchor,
+    Behaviour,
     CameraSpec,
     Leg,
     MannequinSpec,
@@ -32,6 +34,9 @@ from sim.scenario.spec import (
 
 # Clearance between the pedestrian and the kerb line when it stops or turns there.
 KERB_STOP_GAP = 0.2  # m
+# Euro NCAP AEB VRU test protocol: a crossing pedestrian target reaches its speed over
+# 1.0 m (near side) or 1.5 m (far side) from standing.
+ACCELERATION_DISTANCE = {"near": 1.0, "far": 1.5}  # m
 
 
 class Scale(StrEnum):
@@ -177,6 +182,15 @@ class PlacementError(ValueError):
         self.reason = reason
 
 
+def time_to_walk(distance: float, speed: float, accel_distance: float) -> float:
+    """Seconds a rail target takes to walk `distance` from standing: it accelerates at a
+    constant rate over `accel_distance` to `speed` (accel_distance / speed longer than at
+    speed throughout), then keeps it."""
+    if distance <= accel_distance:  # still accelerating: distance = a t^2 / 2
+        return 2 * (distance * accel_distance) ** 0.5 / speed
+    return (distance + accel_distance) / speed
+
+
 def crossing_line_x(
     robot: RobotSpec, footprint: float, impact_time: float, standstill: float
 ) -> float:
@@ -189,16 +203,32 @@ def crossing_line_x(
 
 def place_crossing(
     c: Crossing, robot: RobotSpec, road: RoadLayout, speed: float, looks: MannequinSpec,
-    footprint: float = 0.5,
+    footprint: float = 0.5, behaviour: Behaviour | None = None,
 ) -> PedestrianSpec:  # fmt: skip
-    """The pedestrian of a crossing (see Crossing), legs included for the near misses."""
+    """The pedestrian of a crossing (see Crossing), legs included for the near misses.
+
+    The plan is the rail target's: standing, then accelerating over the acceleration
+    distance (the behaviour's, else the protocol's for the side) and walking on at speed;
+    it passes the impact point at impact_time (the anchor), having walked `approach`
+    metres from where it stood. A human walker meets the same anchor its own way.
+    """
+    behaviour = behaviour or Behaviour()
+    if behaviour.acceleration_distance is None:
+        behaviour = replace(behaviour, acceleration_distance=ACCELERATION_DISTANCE[c.side.value])
+    accel = behaviour.acceleration_distance if behaviour.model == "rail" else 0.0
+    assert accel is not None
     if not speed > 0:
         raise PlacementError("pedestrian.speed", speed, "a crossing pedestrian must walk (> 0 m/s)")
+    if accel > c.approach:
+        raise PlacementError(
+            "path.approach", c.approach,
+            f"shorter than the target's acceleration distance ({accel:g} m)",
+        )  # fmt: skip
     direction = 1.0 if c.side is Side.NEAR else -1.0  # +1 walks north (to the robot's left)
     entering_edge = -direction * robot.width / 2
     y_impact = entering_edge + direction * c.impact_point * robot.width
     x_line = crossing_line_x(robot, footprint, c.impact_time, c.standstill_distance)
-    walk_time = c.approach / speed
+    walk_time = time_to_walk(c.approach, speed, accel)
     start_delay = c.impact_time - walk_time
     if start_delay < 0:
         raise PlacementError(
@@ -220,7 +250,7 @@ def place_crossing(
                 c.approach,
                 f"the pedestrian starts past the kerb (y={y0:.2f} m), so it cannot {c.then} there",
             )
-        at = start_delay + to_kerb / speed
+        at = start_delay + time_to_walk(to_kerb, speed, accel)
         # Turning away: a quarter turn to walk along the pavement in the robot's direction.
         turn = -90.0 * direction
         leg = Leg(at=at, speed=0.0) if c.then is Then.STOP_AT_KERB else Leg(at, speed, turn)
@@ -234,20 +264,26 @@ def place_crossing(
         legs=legs,
         start_delay=start_delay,
         footprint=footprint,
+        behaviour=behaviour,
+        anchor=Anchor(c.impact_time, x_line, y_impact),
     )
 
 
 def place_longitudinal(
-    c: Longitudinal, robot: RobotSpec, speed: float, looks: MannequinSpec, footprint: float = 0.5
-) -> PedestrianSpec:
-    """The pedestrian of a walk along the path (see Longitudinal)."""
+    c: Longitudinal, robot: RobotSpec, speed: float, looks: MannequinSpec, footprint: float = 0.5,
+    behaviour: Behaviour | None = None,
+) -> PedestrianSpec:  # fmt: skip
+    """The pedestrian of a walk along the path (see Longitudinal), walking from the start."""
     y = -robot.width / 2 + c.impact_point * robot.width
     front = robot.length / 2 + footprint / 2
     meet = robot.speed * c.impact_time + front
+    anchor = None
     if c.toward:
         x0 = meet + speed * c.impact_time
+        anchor = Anchor(c.impact_time, meet, y)
     elif robot.speed > speed:
         x0 = meet - speed * c.impact_time
+        anchor = Anchor(c.impact_time, meet, y)
     else:
         x0 = front + c.standstill_distance
     return PedestrianSpec(
@@ -257,6 +293,8 @@ def place_longitudinal(
         speed=speed,
         looks=looks,
         footprint=footprint,
+        behaviour=behaviour or Behaviour(),
+        anchor=anchor,
     )
 
 

@@ -42,8 +42,10 @@ from sim.scenario.families import (
     place_longitudinal,
     street_bounds,
 )
-from sim.scenario.path import PedestrianPath
+from sim.scenario.path import pedestrian_path
 from sim.scenario.spec import (
+    BEHAVIOURS,
+    Behaviour,
     CameraSpec,
     Leg,
     Occluder,
@@ -327,10 +329,13 @@ def build(path: Path, data: Mapping[str, Any]) -> Scenario:
     height = ped_table.number("height", None, low=0.8, high=2.2, unit="m")
     speed = ped_table.number("speed", 1.4, low=0.0, high=10.0, unit="m/s")
     footprint = ped_table.number("footprint", 0.5, positive=True, high=2.0, unit="m")
+    behaviour = _behaviour(ped_table.table("behaviour"))
     ped_table.done()
     looks = mannequin(body, clothing, height)
     path_table = top.table("path")
-    pedestrian, case, x_line = _path(path_table, robot, road, speed, looks, footprint, duration)
+    pedestrian, case, x_line = _path(
+        path_table, robot, road, speed, looks, footprint, duration, behaviour
+    )
     occluders = _parked_cars(top.table("scene").table("parked_cars"), x_line, robot, road)
     top.done()
     scene = SceneSpec(
@@ -354,6 +359,30 @@ def build(path: Path, data: Mapping[str, Any]) -> Scenario:
     )
     _check_on_street(path, scenario)
     return scenario
+
+
+def _behaviour(t: TomlTable) -> Behaviour:
+    """[pedestrian.behaviour]: the walker model and its parameters (scenarios/README.md)."""
+    base = Behaviour()
+    model = t.text("model", base.model, BEHAVIOURS)
+    if model == "rail":
+        distance = t.number("acceleration_distance", None, low=0.0, high=10.0, unit="m")
+        t.done()
+        return Behaviour(model=model, acceleration_distance=distance)
+    behaviour = Behaviour(
+        model=model,
+        start_time=t.number("start_time", base.start_time, low=0.2, high=5.0, unit="s"),
+        stop_time=t.number("stop_time", base.stop_time, low=0.2, high=5.0, unit="s"),
+        max_yaw_rate=t.number(
+            "max_yaw_rate", base.max_yaw_rate, low=10.0, high=360.0, unit="deg/s"
+        ),  # fmt: skip
+        speed_wander=t.number("speed_wander", base.speed_wander, low=0.0, high=0.3),
+        lateral_wander=t.number(
+            "lateral_wander", base.lateral_wander, low=0.0, high=0.5, unit="m"
+        ),  # fmt: skip
+    )
+    t.done()
+    return behaviour
 
 
 def _robot(t: TomlTable, preset: RobotSpec) -> RobotSpec:
@@ -409,6 +438,13 @@ def _scene(t: TomlTable, preset: RoadLayout) -> tuple[RoadLayout, tuple[float, f
         crosswalk_x=crosswalk_x if crosswalk else None,
         buildings=r.flag("buildings", preset.buildings),
     )
+    if crosswalk and abs(crosswalk_x) > road.length / 2:
+        raise r.error(
+            "crosswalk_x",
+            crosswalk_x,
+            f"the crosswalk would lie off the road (x in [{-road.length / 2:g}, "
+            f"{road.length / 2:g}] m)",
+        )
     r.done()
     t.seen.add("parked_cars")  # read by _parked_cars once the path is known
     t.done()
@@ -423,13 +459,14 @@ def _path(
     looks: Any,
     footprint: float,
     duration: float,
+    behaviour: Behaviour,
 ) -> tuple[PedestrianSpec, Case | None, float | None]:
     """The pedestrian's path; also its case and (crossings) the crossing line's x."""
     kind = t.text("kind", choices=PATH_KINDS)
     x_line = None
     try:
         if kind == "case":
-            pedestrian, case = _case_path(t, robot, speed, looks, footprint, duration)
+            pedestrian, case = _case_path(t, robot, speed, looks, footprint, duration, behaviour)
         elif kind == "crossing":
             c = Crossing(
                 side=Side(t.text("side", choices=tuple(s.value for s in Side))),
@@ -437,9 +474,11 @@ def _path(
                 impact_time=t.number("impact_time", positive=True, high=duration, unit="s"),
                 approach=t.number("approach", 4.0, positive=True, high=30.0, unit="m"),
                 then=Then(t.text("then", "walk", tuple(x.value for x in Then))),
-                standstill_distance=t.number("standstill_distance", 4.0, low=0.0, unit="m"),
+                standstill_distance=t.number(
+                    "standstill_distance", 4.0, low=0.0, high=200.0, unit="m"
+                ),
             )
-            pedestrian = place_crossing(c, robot, road, speed, looks, footprint)
+            pedestrian = place_crossing(c, robot, road, speed, looks, footprint, behaviour)
             case = Case.PERPENDICULAR_LEFT if c.side is Side.NEAR else Case.PERPENDICULAR_RIGHT
             x_line = crossing_line_x(robot, footprint, c.impact_time, c.standstill_distance)
         elif kind == "longitudinal":
@@ -448,17 +487,19 @@ def _path(
                 impact_point=t.number("impact_point", low=-5.0, high=6.0),
                 impact_time=t.number("impact_time", positive=True, high=duration, unit="s"),
                 toward=direction == "toward",
-                standstill_distance=t.number("standstill_distance", 4.0, low=0.0, unit="m"),
+                standstill_distance=t.number(
+                    "standstill_distance", 4.0, low=0.0, high=200.0, unit="m"
+                ),
             )
             if not speed > 0:
                 raise PlacementError("pedestrian.speed", speed, "a walking pedestrian needs > 0")
-            pedestrian = place_longitudinal(c2, robot, speed, looks, footprint)
+            pedestrian = place_longitudinal(c2, robot, speed, looks, footprint, behaviour)
             case = Case.TOWARD if c2.toward else Case.AWAY
         else:
             leg_tables = t.tables("legs")
             legs = tuple(
                 Leg(
-                    at=leg.number("at", low=0.0, unit="s"),
+                    at=leg.number("at", low=0.0, high=duration, unit="s"),
                     speed=leg.number("speed", low=0.0, high=10.0, unit="m/s"),
                     turn_deg=leg.number("turn_deg", 0.0, low=-360.0, high=360.0, unit="degrees"),
                 )
@@ -473,8 +514,9 @@ def _path(
                 speed=speed,
                 looks=looks,
                 legs=legs,
-                start_delay=t.number("start_delay", 0.0, low=0.0, unit="s"),
+                start_delay=t.number("start_delay", 0.0, low=0.0, high=duration, unit="s"),
                 footprint=footprint,
+                behaviour=behaviour,
             )
             case = None
     except PlacementError as err:
@@ -490,8 +532,9 @@ PATH_PLACEMENT = ("distance", "lateral_offset", "angle_deg", "meet_time", "facin
 
 
 def _case_path(
-    t: TomlTable, robot: RobotSpec, speed: float, looks: Any, footprint: float, duration: float
-) -> tuple[PedestrianSpec, Case]:
+    t: TomlTable, robot: RobotSpec, speed: float, looks: Any, footprint: float, duration: float,
+    behaviour: Behaviour,
+) -> tuple[PedestrianSpec, Case]:  # fmt: skip
     """sim.scenario.cases.CasePlacement: the path passes (distance, offset) at meet_time."""
     case = Case(t.integer("case", low=1, high=9))
     values: dict[str, Any] = {}
@@ -510,7 +553,7 @@ def _case_path(
     except PlacementError as err:
         key = PLACEMENT_KEYS.get(err.field, f"path.{err.field}")
         raise PlacementError(key, err.value, err.reason) from None
-    scenario = placement.scenario(looks=looks, robot=robot)
+    scenario = placement.scenario(looks=looks, robot=robot, behaviour=behaviour)
     return replace(scenario.pedestrian, footprint=footprint), case
 
 
@@ -533,6 +576,15 @@ def _parked_cars(
     clearance = abs(y) - max(c.width for c in cars) / 2 - robot.width / 2
     if clearance < 0.1:
         raise t.error("y", y, "the parked cars would stand in the robot's path")
+    x0, x1, y0, y1 = street_bounds(road)
+    if not y0 <= y <= y1:
+        raise t.error("y", y, f"the parked cars would stand off the street (y in [{y0:.2f}, "
+                      f"{y1:.2f}] m)")  # fmt: skip
+    for car in cars:
+        if not x0 <= car.x <= x1:
+            key = "x" if placement == "fixed" else "placement"
+            raise t.error(key, t.data.get(key), f"a parked car would stand off the road "
+                          f"(x = {car.x:g} m, the road spans [{x0:g}, {x1:g}] m)")  # fmt: skip
     return cars
 
 
@@ -568,7 +620,7 @@ def street_problem(s: Scenario) -> PlacementError | None:
             f"({end:.1f} m > {road.length / 2:.1f} m): lower the speed or the duration",
         )
     x0, x1, y0, y1 = street_bounds(road)
-    ped = PedestrianPath(s.pedestrian)
+    ped = pedestrian_path(s.pedestrian, s.duration, s.seed)
     times = [0.0, *ped.breakpoints_between(0.0, s.duration), s.duration]
     for t in times:
         x, y = ped.state(t).position

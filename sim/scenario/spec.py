@@ -165,6 +165,49 @@ class Leg:
     turn_deg: float = 0.0
 
 
+BEHAVIOURS = ("rail", "human")
+
+
+@dataclass(frozen=True)
+class Behaviour:
+    """How the pedestrian walks its planned path (scenarios/README.md: units, ranges, sources).
+
+    `rail` is the Euro NCAP pedestrian target: from standing it reaches its speed over
+    `acceleration_distance` at constant acceleration, then moves on straight lines at
+    constant speed; the legs' stops and turns are instant. `human` walks the same plan as
+    a person: starts and stops over a couple of steps (raised-cosine speed profiles),
+    turns along arcs at a bounded yaw rate, and wanders a little in speed and sideways.
+    A placed scenario's `PedestrianSpec.anchor` is honoured by both: the walker passes
+    the anchor point at the anchor time, however it starts.
+    """
+
+    model: str = "rail"
+    # rail: m from standing to speed; None: the placement's default (Euro NCAP AEB VRU
+    # protocol: 1.0 m for near-side targets, 1.5 m for far-side ones).
+    acceleration_distance: float | None = None
+    # human (defaults and their sources in scenarios/README.md):
+    start_time: float = 1.8  # s from standing to walking speed (about three steps)
+    stop_time: float = 1.2  # s from walking speed to standing (about two steps)
+    max_yaw_rate: float = 90.0  # deg/s along a turn
+    speed_wander: float = 0.10  # amplitude of the speed's slow wander, share of its speed
+    lateral_wander: float = 0.15  # m, amplitude of the sideways wander off the plan's line
+    sway: float = 0.02  # m, the body's side-to-side sway once a stride
+    surge: float = 0.12  # the body's speed rising and falling twice a stride, share of it
+
+    def __post_init__(self) -> None:
+        if self.model not in BEHAVIOURS:
+            raise ValueError(f"behaviour model must be one of {', '.join(BEHAVIOURS)}")
+
+
+@dataclass(frozen=True)
+class Anchor:
+    """A point the walker passes at a given time (the placement solved for it)."""
+
+    time: float  # s from the start
+    x: float  # world, m
+    y: float
+
+
 @dataclass(frozen=True)
 class PedestrianSpec:
     """The mannequin (stature, clothing) and its path: start, heading, speed, then legs."""
@@ -177,6 +220,10 @@ class PedestrianSpec:
     legs: tuple[Leg, ...] = ()
     start_delay: float = 0.0  # s standing at the start before walking
     footprint: float = 0.5  # m, side of the square the pedestrian occupies on the ground
+    behaviour: Behaviour = field(default_factory=Behaviour)
+    # Where a placement says the walker is at a time (its plan passes there then); the
+    # walker is shifted to pass it exactly whatever its behaviour. None: no constraint.
+    anchor: Anchor | None = None
 
     def heading_at(self, t: float) -> float:
         """Heading in radians at time t (turns of the legs started so far)."""

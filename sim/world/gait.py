@@ -19,10 +19,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from sim.scenario.stride import ADULT_HEIGHT, IDLE_SPEED, REF_CADENCE, REF_SPEED, step_length
+
 G = 9.81  # m/s^2
-ADULT_HEIGHT = 1.8  # m, the body size the reference gait is given for
-# Below this speed (m/s) the mannequin stands idle instead of walking.
-IDLE_SPEED = 0.05
 
 
 @dataclass(frozen=True)
@@ -74,8 +73,8 @@ class Gait:
     """Walking kinematics for a body of the given height (m)."""
 
     height: float = ADULT_HEIGHT
-    ref_speed: float = 1.4  # m/s, comfortable adult walking speed
-    ref_cadence: float = 1.8  # steps/s at ref_speed for an adult of ADULT_HEIGHT
+    ref_speed: float = REF_SPEED  # m/s, comfortable adult walking speed
+    ref_cadence: float = REF_CADENCE  # steps/s at ref_speed for an adult of ADULT_HEIGHT
 
     @property
     def size_ratio(self) -> float:
@@ -88,10 +87,7 @@ class Gait:
 
     def step_length(self, speed: float) -> float:
         """Step length (m); grows with the square root of the size-normalised speed."""
-        if speed <= IDLE_SPEED:
-            return 0.0
-        comfortable = self.ref_speed * math.sqrt(self.size_ratio)  # same Froude number
-        return self.ref_step * math.sqrt(speed / comfortable)
+        return step_length(speed, self.height, self.ref_speed, self.ref_cadence)
 
     def cadence(self, speed: float) -> float:
         """Steps per second at `speed` (0 when idle)."""

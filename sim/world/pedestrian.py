@@ -1,14 +1,9 @@
-"""The pedestrian: a scenario path, and a highway-env road object that walks it.
+"""The pedestrian: a highway-env road object that walks its Track (sim.scenario.path).
 
-The path is known in closed form (straight pieces at constant speed between the start,
-the end of the start delay and the legs), so the simulator can ask where the pedestrian
-will be at any future time: the case label and the time to collision use exactly the
-motion the body will make, not an extrapolation.
-
-Timing: every time is seconds since the scenario start. The pedestrian stands (facing its
-heading) until `start_delay`, then walks at `speed`; a leg switches speed and turns the
-heading at `leg.at`. Turns of legs that fall inside the start delay are applied while
-standing; their speed applies from the end of the delay.
+The Track is known ahead (straight pieces between vertices, as its behaviour walks the
+plan), so the simulator can ask where the pedestrian will be at any future time: the case
+label and the time to collision use exactly the motion the body will make, not an
+extrapolation. Every time is seconds since the scenario start.
 """
 
 from __future__ import annotations
@@ -21,7 +16,7 @@ from highway_env.road.road import Road
 from highway_env.vehicle.objects import RoadObject
 
 from sim.geometry.highway_frame import highway_vector_to_world, reflect, world_to_highway
-from sim.scenario.path import PathState, PedestrianPath
+from sim.scenario.path import PathState, pedestrian_path
 from sim.scenario.spec import PedestrianSpec
 from sim.world.gait import Gait
 
@@ -35,13 +30,23 @@ class Pedestrian(RoadObject):
     Positions and headings on this object are in highway-env's frame (sim.geometry.highway_frame).
     """
 
-    def __init__(self, road: Road | None, spec: PedestrianSpec, gait: Gait | None = None) -> None:
+    def __init__(
+        self,
+        road: Road | None,
+        spec: PedestrianSpec,
+        gait: Gait | None = None,
+        *,
+        t_end: float = 30.0,
+        seed: int = 0,
+    ) -> None:
+        """`t_end`: how far ahead the walk is worked out (the run and the truth's lookahead);
+        `seed`: the walk's own randomness (a human walker's wander)."""
         if not (math.isfinite(spec.footprint) and spec.footprint > 0):
             raise ValueError(f"pedestrian footprint must be positive, got {spec.footprint}")
         # Per-instance size, set before RoadObject.__init__ computes the diagonal from it.
         self.LENGTH = spec.footprint
         self.WIDTH = spec.footprint
-        self.path = PedestrianPath(spec)
+        self.path = pedestrian_path(spec, t_end, seed)
         self.gait = gait or Gait(height=spec.looks.height)
         self.gait_phase = 0.0
         self.time = 0.0
@@ -52,7 +57,8 @@ class Pedestrian(RoadObject):
 
     def reset(self, gait_phase: float = 0.0) -> None:
         """Back to the start of the path."""
-        self.gait_phase = float(gait_phase) % 1.0
+        phase = self.path.phase(0.0)
+        self.gait_phase = float(gait_phase) % 1.0 if phase is None else phase
         self.hit = False
         self.set_time(0.0)
 
@@ -60,7 +66,8 @@ class Pedestrian(RoadObject):
         """Put the object where its path is at time t."""
         self.time = float(t)
         state = self.path.state(self.time)
-        self.position, self.heading = world_to_highway(state.pose)
+        # highway-env's heading is the footprint's (its polygon is the square on the ground).
+        self.position, self.heading = reflect(state.position, state.footprint_yaw)
         self.speed = state.speed
 
     def act(self, action: object = None) -> None:
@@ -70,8 +77,17 @@ class Pedestrian(RoadObject):
         """Walk `dt` seconds along the path and advance the gait with the distance walked."""
         before = self.path.state(self.time).position
         self.set_time(self.time + dt)
+        phase = self.path.phase(self.time)
+        if phase is not None:  # the walk sets the stride (its body's sway and surge too)
+            self.gait_phase = phase
+            return
         walked = float(np.linalg.norm(self.path.state(self.time).position - before))
         self.gait_phase = self.gait.advance(self.gait_phase, walked / dt, dt)
+
+    @property
+    def body_sways(self) -> bool:
+        """Whether the mannequin's gait sways the pelvis itself (else the walk's track does)."""
+        return self.path.phases is None
 
     @property
     def state(self) -> PathState:
@@ -90,7 +106,7 @@ class Pedestrian(RoadObject):
         """
         state = self.path.state(t)
         ghost = copy.copy(self)
-        ghost.position, ghost.heading = reflect(state.position, state.yaw)
+        ghost.position, ghost.heading = reflect(state.position, state.footprint_yaw)
         return ghost.polygon()
 
     def highway_velocity_at(self, t: float) -> np.ndarray:

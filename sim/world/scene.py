@@ -15,7 +15,7 @@ the camera looks.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import mujoco
 import numpy as np
@@ -225,17 +225,21 @@ class Scene:
         gait_phase: float = 0.0,
         speed: float = 0.0,
         pose: MannequinPose | None = None,
+        sway: bool = True,
     ) -> None:
         """Stand the pedestrian at world (x, y) facing `yaw`.
 
         The body pose comes from the gait at `gait_phase` and `speed` (idle stance when
         the speed is about zero) unless `pose` is given. Advance the phase between
-        frames with `self.gait.advance(phase, speed, dt)`.
+        frames with `self.gait.advance(phase, speed, dt)`. `sway` False: the placement
+        itself sways (a human walker's track), so the pelvis does not sway again.
         """
         self.pedestrian = PedestrianState(
             float(x), float(y), float(yaw), float(gait_phase), float(speed)
         )
         body_pose = pose if pose is not None else self.gait.pose(gait_phase, speed)
+        if not sway:
+            body_pose = replace(body_pose, sway=0.0)
         self.mannequin.place(self.model, self.data, x, y, yaw, body_pose)
         self._update()
 

@@ -103,7 +103,13 @@ class World(Closing):
         self.road = highway_road(self.scenario.scene.road, self.scenario.scene.occluders)
         self.robot = Robot(self.road, self.scenario.robot, ROBOT_START)
         self.road.vehicles.append(self.robot)
-        self.pedestrian = Pedestrian(self.road, self.scenario.pedestrian, self.scene.gait)
+        self.pedestrian = Pedestrian(
+            self.road,
+            self.scenario.pedestrian,
+            self.scene.gait,
+            t_end=self.scenario.duration + self.ttc_lookahead + CASE_WINDOW + 1.0,
+            seed=self.seed,
+        )
         self.pedestrian.reset(gait_phase=float(rng.uniform()))
         self.road.objects.append(self.pedestrian)
         self.time, self.index, self._yaw_rate = 0.0, 0, 0.0
@@ -180,7 +186,12 @@ class World(Closing):
         ped = self.pedestrian.state
         self.scene.set_camera_pose(robot.pose.x, robot.pose.y, robot.pose.yaw)
         self.scene.set_pedestrian(
-            ped.position[0], ped.position[1], ped.yaw, self.pedestrian.gait_phase, ped.speed
+            ped.position[0],
+            ped.position[1],
+            ped.yaw,
+            self.pedestrian.gait_phase,
+            ped.speed,
+            sway=self.pedestrian.body_sways,
         )
         truth = self._ground_truth(robot, ped)
         ego = EgoState(self.camera, robot.speed, robot.yaw_rate)

@@ -47,7 +47,7 @@ def test_paper_metric_pairs_frame_j_with_prediction_j_minus_1():
 
 def _row(**values: float) -> dict[str, float]:
     base = {c: 0.0 for c in COLUMNS}
-    base.update(windowSize=4, timeToFuture=1, occupiedHeights=0.5, angleOfApproach=90.0)
+    base.update(windowSize=4, timeToFuture=1, fps=15, occupiedHeights=0.5, angleOfApproach=90.0)
     base.update(values)
     return base
 

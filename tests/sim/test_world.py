@@ -19,7 +19,7 @@ from monopic.features.orientation import facing_angle
 from sim.geometry.frames import Pose2D, wrap_angle
 from sim.geometry.highway_frame import highway_to_world, reflect, world_to_highway
 from sim.scenario.cases import CasePlacement, case_heading_deg, default_crossing
-from sim.scenario.path import PedestrianPath
+from sim.scenario.path import rail_track
 from sim.scenario.spec import (
     CameraSpec,
     Leg,
@@ -197,7 +197,7 @@ def test_pedestrian_path_with_delay_stop_and_turn() -> None:
         start_delay=1.0,
         legs=(Leg(at=3.0, speed=0.0), Leg(at=4.0, speed=2.0, turn_deg=90.0)),
     )
-    path = PedestrianPath(spec)
+    path = rail_track(spec, acceleration_distance=0.0)  # the plan itself
     assert np.allclose(path.state(0.5).position, [1.0, 2.0]) and path.state(0.5).speed == 0.0
     assert np.allclose(path.state(2.0).position, [2.0, 2.0])
     assert np.allclose(path.state(3.5).position, [3.0, 2.0]) and path.state(3.5).speed == 0.0

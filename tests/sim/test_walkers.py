@@ -1,0 +1,182 @@
+"""The pedestrian's behaviour models: the Euro NCAP rail target and the human walker."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from monopic.errors import UserError
+from sim.scenario.files import load
+from sim.scenario.path import H, pedestrian_path, rail_track
+from sim.scenario.spec import Anchor, Behaviour, Leg, PedestrianSpec
+from sim.world.world import World
+from tests.paths import SCENARIOS
+
+HUMAN = Behaviour(model="human")
+
+
+def speeds(track, t0: float, t1: float, dt: float = H) -> tuple[np.ndarray, np.ndarray]:
+    times = np.arange(t0, t1, dt)
+    p = track.positions_at(times)
+    return times[:-1], np.hypot(*np.diff(p, axis=0).T) / dt
+
+
+def test_the_rail_target_reaches_its_speed_over_the_acceleration_distance():
+    spec = PedestrianSpec(x=0.0, y=0.0, heading_deg=90.0, speed=1.39, start_delay=1.0)
+    track = rail_track(spec, acceleration_distance=1.0)
+    ramp = 2 * 1.0 / 1.39  # s: constant acceleration from 0 to 1.39 m/s over 1 m
+    assert track.state(1.0).position == pytest.approx([0.0, 0.0])
+    assert track.state(1.0 + ramp).position == pytest.approx([0.0, 1.0], abs=1e-9)
+    assert track.state(1.0 + ramp + 2.0).position == pytest.approx([0.0, 1.0 + 2 * 1.39])
+    half = track.state(1.0 + ramp / 2).position[1]
+    assert half == pytest.approx(0.25, abs=1e-3)  # a t^2 / 2: a quarter of the distance
+    assert track.state(5.0).speed == pytest.approx(1.39)
+    # Distance 0 is the plan itself: an instant start.
+    assert rail_track(spec, 0.0).state(2.0).position == pytest.approx([0.0, 1.39])
+
+
+def test_an_anchor_is_met_exactly_by_both_behaviours():
+    anchor = Anchor(time=3.0, x=4.0, y=0.5)
+    for behaviour in (Behaviour(), HUMAN):
+        spec = PedestrianSpec(x=4.0, y=-3.0, heading_deg=90.0, speed=1.39, start_delay=0.5,
+                              behaviour=behaviour, anchor=anchor)  # fmt: skip
+        for seed in (0, 1, 2):
+            track = pedestrian_path(spec, 6.0, seed)
+            assert track.state(3.0).position == pytest.approx([4.0, 0.5], abs=1e-9)
+
+
+def human_crossing(seed: int = 3) -> tuple[PedestrianSpec, object]:
+    spec = PedestrianSpec(x=0.0, y=-4.0, heading_deg=90.0, speed=1.4, start_delay=1.0,
+                          behaviour=HUMAN)  # fmt: skip
+    return spec, pedestrian_path(spec, 8.0, seed)
+
+
+def test_a_human_sets_off_over_steps_not_in_a_frame():
+    spec, track = human_crossing()
+    t, v = speeds(track, 0.0, 6.0, dt=0.1)
+    assert np.all(v[t < 0.9] < 1e-9)  # standing first
+    moving = np.flatnonzero(v > 0.05)
+    start = t[moving[0]]
+    at_speed = t[np.flatnonzero(v > 0.9 * 1.4)[0]]
+    assert 1.0 <= at_speed - start <= 2.5  # about three steps, not one frame
+    accel = np.abs(np.diff(v)) / 0.1
+    assert accel.max() < 2.5  # m/s2: bounded, even with the stride's surge
+
+
+def test_a_human_stops_exactly_where_the_plan_stops_and_over_about_a_second():
+    spec = PedestrianSpec(x=0.0, y=-4.0, heading_deg=90.0, speed=1.4, start_delay=0.5,
+                          legs=(Leg(at=2.5, speed=0.0),), behaviour=HUMAN)  # fmt: skip
+    plan_stop = rail_track(spec, 0.0).state(2.5).position
+    track = pedestrian_path(spec, 8.0, seed=1)
+    end = track.state(7.0)
+    assert end.speed == 0.0
+    # The stop is on the plan's stopping line (the wander moves it sideways only).
+    assert end.position[1] == pytest.approx(plan_stop[1], abs=0.03)
+    t, v = speeds(track, 0.0, 7.0, dt=0.1)
+    slowing = t[(v < 0.9 * 1.4) & (t > 2.0) & (v > 0.05)]
+    assert slowing.max() - slowing.min() >= 0.5  # over steps, not a frame
+
+
+def test_a_human_turns_along_an_arc_at_a_bounded_yaw_rate():
+    spec = PedestrianSpec(x=0.0, y=-4.0, heading_deg=90.0, speed=1.4,
+                          legs=(Leg(at=2.0, speed=1.4, turn_deg=-90.0),),
+                          behaviour=Behaviour(model="human", lateral_wander=0.0, sway=0.0,
+                                              surge=0.0))  # fmt: skip
+    track = pedestrian_path(spec, 6.0, seed=0)
+    times = np.arange(0.0, 5.0, 0.05)
+    yaws = np.unwrap([track.state(float(t)).yaw for t in times])
+    rate = np.degrees(np.abs(np.diff(yaws))) / 0.05
+    assert rate.max() <= 90.0 * 1.05  # the yaw-rate bound (a little for the speed wander)
+    assert yaws[-1] - yaws[0] == pytest.approx(-math.pi / 2, abs=0.02)
+    turning = times[1:][rate > 10.0]
+    assert turning.max() - turning.min() >= 0.6  # a curve, not a corner
+
+
+def test_the_wander_is_the_seeds_and_a_standing_person_does_not_drift():
+    spec, a = human_crossing(seed=3)
+    _, b = human_crossing(seed=3)
+    _, c = human_crossing(seed=4)
+    assert np.array_equal(a.positions, b.positions)
+    assert not np.allclose(a.positions_at(np.array([4.0])), c.positions_at(np.array([4.0])))
+    standing = a.positions_at(np.linspace(0.0, 0.8, 20))
+    assert np.ptp(standing, axis=0) == pytest.approx([0.0, 0.0], abs=1e-12)
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 10_000), t=st.floats(0.0, 7.9))
+def test_a_tracks_state_is_its_pieces(seed: int, t: float):
+    """Position at any time is the piece's start plus its velocity: the truth's straight pieces."""
+    _, track = human_crossing(seed)
+    k = int(np.searchsorted(track.times, t, side="right")) - 1
+    expected = track.positions[k] + (t - track.times[k]) * track.velocities[k]
+    assert track.state(t).position == pytest.approx(expected)
+    nxt = min(k + 1, len(track.times) - 1)
+    if nxt > k:  # continuous: a piece ends where the next begins
+        end = track.positions[k] + (track.times[nxt] - track.times[k]) * track.velocities[k]
+        assert end == pytest.approx(track.positions[nxt], abs=1e-9)
+
+
+def first_overlap_brute_force(world: World, t_end: float) -> float | None:
+    """The first time (1 ms steps) the robot, keeping its course, overlaps the pedestrian."""
+    from highway_env import utils
+
+    robot, ped = world.robot, world.pedestrian
+    assert robot is not None and ped is not None
+    for t in np.arange(0.0, t_end, 0.001):
+        ghost = robot.polygon() + t * robot.velocity
+        if utils.are_polygons_intersecting(ghost, ped.polygon_at(float(t)), np.zeros(2),
+                                           np.zeros(2))[0]:  # fmt: skip
+            return float(t)
+    return None
+
+
+@pytest.mark.parametrize(
+    "file", ["families/small/cross_impact.toml", "cases/case4_oblique_left_toward.toml"]
+)
+def test_the_time_to_contact_of_a_human_walker_agrees_with_a_brute_force_search(file: str):
+    f = load(SCENARIOS / file)
+    scenario = f.scenario({"pedestrian.behaviour.model": "human", "robot.speed": 2.0}, "t", 5)
+    with World(scenario, render=False) as world:
+        truth = world.reset().truth
+        brute = first_overlap_brute_force(world, scenario.duration)
+        if brute is None:
+            assert truth.time_to_collision is None or truth.time_to_collision > scenario.duration
+        else:
+            assert truth.time_to_collision == pytest.approx(brute, abs=0.0015)
+
+
+@pytest.mark.parametrize(
+    ("table", "expected"),
+    [
+        ('model = "robot"', "pedestrian.behaviour.model = 'robot': must be one of"),
+        (
+            'model = "human"\nstart_time = 0.0',
+            "pedestrian.behaviour.start_time = 0.0: must be >= 0.2",
+        ),
+        ('model = "rail"\nstart_time = 1.0', "pedestrian.behaviour.start_time = 1.0: unknown key"),
+        ('model = "rail"\nacceleration_distance = -1', "acceleration_distance = -1: must be >= 0"),
+        ('model = "human"\nlateral_wander = 2.0', "lateral_wander = 2.0: must be <= 0.5"),
+    ],
+)
+def test_bad_behaviour_values_are_one_line_naming_file_field_and_value(tmp_path, table, expected):
+    text = (SCENARIOS / "families/small/cpna25.toml").read_text()
+    text = text.replace("[path]", f"[pedestrian.behaviour]\n{table}\n\n[path]", 1)
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    with pytest.raises(UserError) as err:
+        load(path)
+    message = str(err.value)
+    assert message.startswith(str(path)) and expected in message and "\n" not in message
+
+
+def test_every_collision_and_near_miss_family_has_a_human_version():
+    """The behaviour is a parameter of every family: the same file, either walker."""
+    for path in sorted((SCENARIOS / "families").glob("*/*.toml")):
+        f = load(path)
+        for model in ("rail", "human"):
+            scenario = f.scenario({"pedestrian.behaviour.model": model}, f.name, 0)
+            assert scenario.pedestrian.behaviour.model == model
