@@ -58,7 +58,7 @@ def test_physically_absurd_values_are_refused_with_file_field_and_value(
 def test_the_same_files_with_sensible_values_load(tmp_path: Path) -> None:
     sensible = [
         (2.0, CASE + "[scene.road]\ncrosswalk_x = -20.0\n"),
-        (0.0, CROSSING + "standstill_distance = 12.0\n"),
+        (0.0, CROSSING + "approach = 2.5\nstandstill_distance = 12.0\n"),  # walkable in 3 s
         (2.0, EXPLICIT + "start_delay = 1.0\nlegs = [{at = 2.5, speed = 1.0}]\n"),
         (2.0, CASE + PARKED + "y = -4.0\nx = [5.0, 60.0]\n"),
     ]
