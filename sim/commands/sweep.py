@@ -92,7 +92,7 @@ def run(args: argparse.Namespace) -> int:
         executor = ray_executor(args.address)
     else:
         executor = local_executor(args.workers)
-    with logs_above_the_bar(args.executor):
+    with logs_above_the_bar(args.executor, args.address):
         outcome = run_sweep(
             spec,
             out,
@@ -118,20 +118,31 @@ def run(args: argparse.Namespace) -> int:
 
 
 @contextmanager
-def logs_above_the_bar(executor: str) -> Iterator[None]:
+def logs_above_the_bar(executor: str, address: str | None = None) -> Iterator[None]:
     """Ray's log lines (its start, the code upload, its warnings) written above the sweep's
     progress bar through tqdm, instead of into the bar's line.
 
-    Ray logs through the 'ray' logger's own stderr handler, set up when ray is imported;
-    Ray is imported here so that handler exists to be redirected for the sweep."""
+    Ray logs through the 'ray' logger's own stderr handler, which exists once ray is
+    imported, so ray is imported here, before the sweep, as the executor imports it: with
+    the executor's connect timeouts set when joining a cluster (Ray reads them as it
+    loads; sim.runs.executors.RAY_CONNECT_ENV). Lines Ray's C++ core writes to stderr
+    itself bypass logging and are not redirected."""
     if executor != "ray":
         yield
         return
+    from sim.runs.executors import RAY_CONNECT_ENV
+
+    joining = (address or os.environ.get("RAY_ADDRESS", "local")) != "local"
+    added = {k: v for k, v in RAY_CONNECT_ENV.items() if joining and k not in os.environ}
+    os.environ.update(added)
     try:
         import ray  # noqa: F401
     except ImportError:  # the executor says how to install it
         yield
         return
+    finally:
+        for key in added:
+            os.environ.pop(key, None)
     from tqdm.contrib.logging import logging_redirect_tqdm
 
     with logging_redirect_tqdm(loggers=[logging.getLogger("ray")]):

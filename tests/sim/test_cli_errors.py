@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import tomllib
 from pathlib import Path
 
@@ -266,11 +267,17 @@ def test_ray_log_lines_go_above_the_progress_bar_not_into_it(
         logging.getLogger("ray._private.worker").warning("Started a local Ray instance.")
         bar.update(1)
     assert ray_logger.handlers == before  # restored after the sweep
+    # Joining a cluster: ray is imported under the executor's connect timeouts, which do
+    # not outlive the import (a local instance's processes must not inherit them).
+    from sim.runs.executors import RAY_CONNECT_ENV
+
+    with logs_above_the_bar("ray", "127.0.0.1:1"):
+        assert not set(RAY_CONNECT_ENV) & set(os.environ)
     err = capsys.readouterr().err
     (logged,) = [seg for seg in err.split("\r") if "Started a local" in seg]
     # tqdm.write: the bar's line cleared, the message on a line of its own, the bar redrawn
     # after it; without the redirect the message is glued to the bar's text ("| 1/2 [...]").
-    assert logged.endswith("-- Started a local Ray instance.\n") and "|" not in logged, err
+    assert logged.endswith("Started a local Ray instance.\n") and "|" not in logged, err
 
 
 @pytest.mark.slow
