@@ -380,6 +380,8 @@ def _behaviour(t: TomlTable) -> Behaviour:
         lateral_wander=t.number(
             "lateral_wander", base.lateral_wander, low=0.0, high=0.5, unit="m"
         ),  # fmt: skip
+        sway=t.number("sway", base.sway, low=0.0, high=0.1, unit="m"),
+        surge=t.number("surge", base.surge, low=0.0, high=0.3),
     )
     t.done()
     return behaviour

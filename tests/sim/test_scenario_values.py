@@ -19,7 +19,10 @@ speed = {robot_speed}
 speed = 1.4
 """
 CASE = '[path]\nkind = "case"\ncase = 5\ndistance = 6.0\n'
-CROSSING = '[path]\nkind = "crossing"\nside = "near"\nimpact_point = 0.5\nimpact_time = 3.0\n'
+CROSSING = (
+    '[path]\nkind = "crossing"\nside = "near"\nimpact_point = 0.5\nimpact_time = 3.0\n'
+    "approach = 3.0\n"  # m: the rail target accelerates over 1 m, so 3 m fit in 3 s
+)
 ALONG = '[path]\nkind = "longitudinal"\nimpact_point = 0.5\nimpact_time = 2.0\n'
 EXPLICIT = '[path]\nkind = "explicit"\nx = 5.0\ny = -3.0\nheading_deg = 90.0\n'
 PARKED = '[scene.parked_cars]\nplacement = "fixed"\n'
@@ -58,7 +61,7 @@ def test_physically_absurd_values_are_refused_with_file_field_and_value(
 def test_the_same_files_with_sensible_values_load(tmp_path: Path) -> None:
     sensible = [
         (2.0, CASE + "[scene.road]\ncrosswalk_x = -20.0\n"),
-        (0.0, CROSSING + "approach = 2.5\nstandstill_distance = 12.0\n"),  # walkable in 3 s
+        (0.0, CROSSING + "standstill_distance = 12.0\n"),
         (2.0, EXPLICIT + "start_delay = 1.0\nlegs = [{at = 2.5, speed = 1.0}]\n"),
         (2.0, CASE + PARKED + "y = -4.0\nx = [5.0, 60.0]\n"),
     ]
