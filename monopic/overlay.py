@@ -18,6 +18,7 @@ RISK_COLOURS = {Risk.GREEN: (40, 200, 60), Risk.YELLOW: (240, 200, 0), Risk.RED:
 SKELETON = (80, 220, 255)
 SHOULDERS = (255, 60, 200)
 PREDICTION = (255, 255, 255)
+OUTLINE_PX = 2  # width of the dark edge around text
 
 
 def _pt(p) -> tuple[int, int]:
@@ -75,8 +76,27 @@ def draw(image: np.ndarray, result: FrameResult, variant: Variant, fps: float) -
 
 
 def _text(img, text, org, colour=(255, 255, 255), size: float = 0.6) -> None:
+    """Text with a dark outline, drawn in place.
+
+    The outline is the text's own mask grown by OUTLINE_PX, not the text drawn again
+    thicker: under OpenCV 5 a thicker stroke also widens every character's advance, so a
+    thick black copy ran ahead of the text on it ("perpendicular rightt")."""
     scale = max(img.shape[0] / 432, 0.5) * size
     thick = max(1, round(2 * scale))
     font = cv2.FONT_HERSHEY_SIMPLEX
-    cv2.putText(img, text, org, font, scale, (0, 0, 0), thick + 2, cv2.LINE_AA)
-    cv2.putText(img, text, org, font, scale, colour, thick, cv2.LINE_AA)
+    (w, h), base = cv2.getTextSize(text, font, scale, thick)
+    pad = OUTLINE_PX + thick
+    x0, y0 = max(org[0] - pad, 0), max(org[1] - h - pad, 0)
+    x1, y1 = min(org[0] + w + pad, img.shape[1]), min(org[1] + base + pad, img.shape[0])
+    if x1 <= x0 or y1 <= y0:
+        return  # entirely outside the image
+    mask = np.zeros((y1 - y0, x1 - x0), np.uint8)
+    cv2.putText(mask, text, (org[0] - x0, org[1] - y0), font, scale, 255, thick, cv2.LINE_AA)
+    kernel = cv2.getStructuringElement(cv2.MORPH_ELLIPSE, (2 * OUTLINE_PX + 1,) * 2)
+    outline = cv2.dilate(mask, kernel)
+    region = img[y0:y1, x0:x1].astype(np.float32)
+    a_out = (outline.astype(np.float32) / 255.0)[..., None]
+    a_text = (mask.astype(np.float32) / 255.0)[..., None]
+    region *= 1.0 - a_out  # black outline
+    region = region * (1.0 - a_text) + np.asarray(colour, np.float32) * a_text
+    img[y0:y1, x0:x1] = np.clip(np.rint(region), 0, 255).astype(img.dtype)

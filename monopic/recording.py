@@ -50,8 +50,8 @@ FEATURE_COLOURS = {"phi": PIPELINE_COLOUR, "vx": (255, 150, 50), "vy": (170, 130
 PREDICTOR_COLOURS = {
     "rules/image": (255, 80, 200),
     "rules/ground": (255, 170, 230),
-    "id3-tree/image": (255, 190, 30),
-    "id3-tree/ground": (255, 230, 140),
+    "tree/image": (255, 190, 30),
+    "tree/ground": (255, 230, 140),
     "constant-velocity/image": (150, 110, 255),
     "constant-velocity/ground": (200, 185, 255),
 }

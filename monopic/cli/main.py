@@ -7,7 +7,7 @@ import signal
 import sys
 import threading
 from collections.abc import Sequence
-from importlib.metadata import EntryPoint, entry_points
+from importlib.metadata import EntryPoint, entry_points, version
 
 from monopic.errors import UserError
 
@@ -33,7 +33,15 @@ class OneLineParser(argparse.ArgumentParser):
 
 def build_parser() -> argparse.ArgumentParser:
     parser = OneLineParser(
-        prog="monopic", description="MonoPIC pedestrian intention pipeline and test bed"
+        prog="monopic",
+        description="MonoPIC pedestrian intention pipeline and test bed. `monopic COMMAND "
+        "--help` describes each command; README.md has a first-ten-minutes walkthrough.",
+    )
+    parser.add_argument(
+        "--version",
+        action="version",
+        version=f"monopic {version('monopic')}",
+        help="print the version and stop",
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     found = command_entry_points()

@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
+from monopic.cli.args import output_file
 from monopic.cli.tree import add_training_options, training_options
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
@@ -35,7 +36,9 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         description=DESCRIPTION,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("logs", nargs="+", type=Path, metavar="LOG.csv")
+    p.add_argument(
+        "logs", nargs="+", type=Path, metavar="LOG.csv", help="logs in the authors' CSV format"
+    )
     p.add_argument("--tree", type=Path, metavar="TREE.json", help="judge with this tree")
     p.add_argument(
         "--csv",
@@ -50,12 +53,12 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 def _replay(args: argparse.Namespace) -> int:
     out: Path | None = args.csv
-    if out is not None and not out.parent.is_dir():
-        raise UserError(f"{out}: directory {out.parent} does not exist")
     model = load_model(args.tree) if args.tree is not None else None
     if model is not None and model.mode is not Mode.IMAGE:
         raise UserError(f"{args.tree}: a {model.mode.value}-mode tree; replay needs image mode")
     prepared = [prepare(read_log(path)) for path in args.logs]
+    if out is not None:
+        output_file(out, "--csv")
     try:
         results = replay(prepared, model, training_options(args))
     except ValueError as err:

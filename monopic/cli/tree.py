@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from monopic.cli.args import non_negative_float, positive_int
+from monopic.cli.args import non_negative_float, output_file, positive_int
 from monopic.errors import UserError
 from monopic.replay.dataset import prepare
 from monopic.replay.logs import read_log
@@ -50,7 +50,12 @@ def training_options(args: argparse.Namespace) -> TrainOptions:
 
 
 def register(subparsers: argparse._SubParsersAction) -> None:
-    p = subparsers.add_parser("tree", help="train or inspect the ID3 decision tree")
+    p = subparsers.add_parser(
+        "tree",
+        help="train or inspect the ID3 decision tree",
+        description="The ID3 decision tree over the discretised (phi, vx, vy): `tree train` "
+        "fits one on logs in the authors' CSV format, `tree show` prints a tree file.",
+    )
     sub = p.add_subparsers(dest="tree_command", required=True, metavar="ACTION")
 
     t = sub.add_parser(
@@ -60,13 +65,22 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         "the 0.5 s warm-up with a full next second), labelled with the case of the next "
         "second of motion; print the gain table and the tree; write versioned JSON.",
     )
-    t.add_argument("data", nargs="+", type=Path, metavar="DATA.csv")
-    t.add_argument("--out", required=True, type=Path, metavar="TREE.json")
+    t.add_argument(
+        "data", nargs="+", type=Path, metavar="DATA.csv", help="logs in the authors' CSV format"
+    )
+    t.add_argument(
+        "--out", required=True, type=Path, metavar="TREE.json", help="the tree file to write"
+    )
     add_training_options(t)
     t.set_defaults(func=_train)
 
-    s = sub.add_parser("show", help="print a tree file (text, gains, operation counts)")
-    s.add_argument("tree", type=Path, metavar="TREE.json")
+    s = sub.add_parser(
+        "show",
+        help="print a tree file (text, gains, operation counts)",
+        description="Print a tree file: its nodes as text, the root's information gains, "
+        "its provenance and the operations a prediction costs (or Graphviz DOT with --dot).",
+    )
+    s.add_argument("tree", type=Path, metavar="TREE.json", help="a file `tree train` wrote")
     s.add_argument("--dot", action="store_true", help="print Graphviz DOT instead")
     s.set_defaults(func=_show)
 
@@ -77,9 +91,7 @@ def _train(args: argparse.Namespace) -> int:
         model = train_on_logs(logs, training_options(args))
     except ValueError as err:
         raise UserError(str(err)) from err
-    out: Path = args.out
-    if not out.parent.is_dir():
-        raise UserError(f"{out}: directory {out.parent} does not exist")
+    out = output_file(args.out, "--out")
     save_model(model, out)
     print(summary(model))
     print(f"\nwrote {out}")

@@ -12,7 +12,7 @@ import cv2
 from tqdm import tqdm
 
 from monopic.camera import CameraModel
-from monopic.cli.args import non_negative_float, positive_float, positive_int
+from monopic.cli.args import non_negative_float, output_file, positive_float, positive_int
 from monopic.errors import UserError
 from monopic.frame import EgoState
 from monopic.framelog import FRAME_COLUMNS, authors_finite, frame_row
@@ -26,22 +26,70 @@ from monopic.video import VideoSource
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("video", help="run the pipeline on a video file or camera")
+    p = sub.add_parser(
+        "video",
+        help="run the pipeline on a video file or camera",
+        description="Run the pipeline (pose, facing angle phi, image velocity, the motion case, "
+        "the point a second ahead, the collision warning) on every frame of a video or camera "
+        "and write what you ask for: an annotated video (--out), one CSV row per frame with "
+        "a person (--csv) and/or a rerun recording (--rrd); at least one is needed. Folders "
+        "are made as needed; every output appears whole or not at all.",
+    )
     p.add_argument("input", help="video file OpenCV reads, or a camera index such as 0")
-    p.add_argument("--variant", choices=[v.value for v in Variant], default="warning")
-    p.add_argument("--out", type=Path, help="annotated video to write (.mp4)")
-    p.add_argument("--csv", type=Path, help="per-frame CSV (authors' columns plus ours)")
-    p.add_argument("--rrd", type=Path, help="rerun recording to write")
-    p.add_argument("--horizon", type=positive_float, default=1.0, help="seconds ahead (1.0)")
-    p.add_argument("--mode", choices=[m.value for m in Mode], default="image")
-    p.add_argument("--predictor", choices=predictor_names(), default="rules")
-    p.add_argument("--tree", type=Path, help="tree file for --predictor tree (default: shipped)")
-    p.add_argument("--threads", type=positive_int, default=1, help="onnxruntime threads")
+    p.add_argument(
+        "--variant",
+        choices=[v.value for v in Variant],
+        default="warning",
+        help="what the annotated video shows: warning (the robot's zone coloured by risk, "
+        "COLLISION IMMINENT), path (the zone and the predicted path with its conflict point) "
+        "or direction (the case and its arrow) (default %(default)s)",
+    )
+    p.add_argument("--out", type=Path, metavar="VIDEO.mp4", help="annotated video to write")
+    p.add_argument(
+        "--csv", type=Path, metavar="FRAMES.csv", help="per-frame CSV (authors' columns plus ours)"
+    )
+    p.add_argument("--rrd", type=Path, metavar="RUN.rrd", help="rerun recording to write")
+    p.add_argument(
+        "--horizon", type=positive_float, default=1.0, help="seconds ahead (default %(default)g)"
+    )
+    p.add_argument(
+        "--mode",
+        choices=[m.value for m in Mode],
+        default="image",
+        help="image: the paper's method, motion measured on the image; ground: the foot "
+        "point on the ground plane with the robot's own motion taken out (needs --fov and "
+        "--camera-height) (default %(default)s)",
+    )
+    p.add_argument(
+        "--predictor",
+        choices=predictor_names(),
+        default="rules",
+        help="the decision stage, by its registry name (default %(default)s)",
+    )
+    p.add_argument(
+        "--tree",
+        type=Path,
+        metavar="TREE.json",
+        help="tree file for --predictor tree (default: the shipped tree)",
+    )
+    p.add_argument(
+        "--threads", type=positive_int, default=1, help="onnxruntime threads (default %(default)d)"
+    )
     g = p.add_argument_group("camera geometry (needed for ground mode and the projected zone)")
     g.add_argument("--fov", type=positive_float, help="vertical field of view, degrees")
     g.add_argument("--camera-height", type=positive_float, help="metres above the ground")
-    g.add_argument("--pitch", type=float, default=0.0, help="degrees, positive looks down")
-    g.add_argument("--speed", type=non_negative_float, default=0.0, help="robot speed, m/s")
+    g.add_argument(
+        "--pitch",
+        type=float,
+        default=0.0,
+        help="degrees, positive looks down (default %(default)g)",
+    )
+    g.add_argument(
+        "--speed",
+        type=non_negative_float,
+        default=0.0,
+        help="robot speed, m/s (default %(default)g)",
+    )
     p.set_defaults(func=run)
 
 
@@ -54,10 +102,15 @@ def run(args: argparse.Namespace) -> int:
     mode = Mode(args.mode)
     if mode is Mode.GROUND and ego is None:
         raise UserError("--mode ground needs the camera geometry: --fov and --camera-height")
-    for out in (args.out, args.csv, args.rrd):
-        if out is not None and not out.parent.is_dir():
-            raise UserError(f"{out}: its folder {out.parent} does not exist")
+    if args.out is None and args.csv is None and args.rrd is None:
+        raise UserError(
+            "nothing to write: give --out VIDEO.mp4, --csv FRAMES.csv and/or --rrd RUN.rrd "
+            "(without them the run would only count the frames with a person)"
+        )
     predictor = make_predictor(args.predictor, mode, args.tree)
+    for option, out in (("--out", args.out), ("--csv", args.csv), ("--rrd", args.rrd)):
+        if out is not None:
+            output_file(out, option)
     pipeline = Pipeline(
         PipelineConfig(
             horizon=args.horizon, mode=mode, tracker=TrackerConfig(threads=args.threads)

@@ -22,7 +22,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "comes with rerun-sdk). Without a display ($DISPLAY and $WAYLAND_DISPLAY unset) it "
         "prints how to view the file instead and exits with status 1.",
     )
-    p.add_argument("file", type=Path, metavar="FILE.rrd")
+    p.add_argument("file", type=Path, metavar="FILE.rrd", help="a .rrd file (record, sweep)")
     p.set_defaults(func=run)
 
 

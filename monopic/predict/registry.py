@@ -31,14 +31,30 @@ def predictor_names() -> tuple[str, ...]:
     return tuple(sorted(_registered()))
 
 
-def make_predictor(name: str, mode: Mode, model: Path | None = None) -> Predictor:
-    """The named predictor for `mode`; `model` is its model file where it takes one."""
-    entry = _registered().get(name)
-    if entry is None:
+def check_predictor_name(name: str) -> None:
+    """UserError (one line, the known names) unless `name` is an installed predictor."""
+    if name not in _registered():
         known = ", ".join(predictor_names()) or "none installed: pip install -e ."
         raise UserError(f"unknown predictor {name!r}: choose from {known}")
+
+
+def make_predictor(name: str, mode: Mode, model: Path | None = None) -> Predictor:
+    """The named predictor for `mode`; `model` is its model file where it takes one.
+
+    The predictor must call itself by its registry name: its decisions are stored and
+    reported as "<name>/<mode>", and commands take that same key (closed-loop --policies),
+    so there is one vocabulary from the command line to the report.
+    """
+    check_predictor_name(name)
+    entry = _registered()[name]
     factory: PredictorFactory = entry.load()
-    return factory(mode, model)
+    predictor = factory(mode, model)
+    if predictor.name != name:
+        raise UserError(
+            f"predictor {name!r} ({entry.value}) calls itself {predictor.name!r}: its name "
+            "attribute must be its entry-point name, which results and reports use"
+        )
+    return predictor
 
 
 def no_model(name: str, model: Path | None) -> None:

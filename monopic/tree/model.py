@@ -150,7 +150,7 @@ class TreePredictor:
 
     model: TreeModel
     placement: Placement = Placement.LEAF
-    name: str = "id3-tree"
+    name: str = "tree"  # its name in the predictor registry (results say "tree/image")
 
     @property
     def mode(self) -> Mode:

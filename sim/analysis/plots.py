@@ -7,6 +7,7 @@ and is written under a temporary name then renamed.
 from __future__ import annotations
 
 import math
+import zlib
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -27,16 +28,31 @@ from sim.analysis.metrics import (
 )
 from sim.runs.result import RunResult
 
-COLOURS = {"rules": "#1f77b4", "id3-tree": "#ff7f0e", "constant-velocity": "#2ca02c"}
+# One colour per predictor and mode (matplotlib's tab10), so the histograms and bars, which
+# have no line style to tell image from ground mode, keep them apart too.
+COLOURS = {
+    "rules/image": "#1f77b4",
+    "rules/ground": "#9467bd",
+    "tree/image": "#ff7f0e",
+    "tree/ground": "#8c564b",
+    "constant-velocity/image": "#2ca02c",
+    "constant-velocity/ground": "#d62728",
+}
+OTHER_COLOURS = ("#e377c2", "#17becf", "#bcbd22", "#7f7f7f")  # other predictors, by name
 DPI = 110
 
 
+def colour(key: str) -> str:
+    """The fixed colour of a predictor key ("rules/image"); another predictor's is stable."""
+    return COLOURS.get(key) or OTHER_COLOURS[zlib.crc32(key.encode()) % len(OTHER_COLOURS)]
+
+
 def style(method: str) -> dict[str, object]:
-    """Colour by predictor, dashes for ground mode, thin dotted for the ablation."""
+    """Colour by predictor and mode, dashes for ground mode, thin dotted for the ablation."""
     pipeline, key = split_method(method)
-    name, _, mode = key.partition("/")
+    mode = key.partition("/")[2]
     out: dict[str, object] = {
-        "color": COLOURS.get(name, "#7f7f7f"),
+        "color": colour(key),
         "linestyle": "--" if mode == "ground" else "-",
         "linewidth": 2.0,
         "label": method,

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 from tqdm import tqdm
 
-from monopic.cli.args import non_negative_float
+from monopic.cli.args import non_negative_float, output_file, output_folder
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
 
@@ -35,20 +35,36 @@ def register(sub: argparse._SubParsersAction) -> None:
         "per policy. Default scenarios: the small-robot Euro NCAP-style collision families "
         f"({', '.join(NCAP_FAMILIES)} in {FAMILY_FOLDER}) at each --speeds.",
     )
-    p.add_argument("files", nargs="*", type=Path, metavar="SCENARIO.toml")
+    p.add_argument(
+        "files",
+        nargs="*",
+        type=Path,
+        metavar="SCENARIO.toml",
+        help="scenario files, each run at every --speeds (default: the families above)",
+    )
     p.add_argument(
         "--cases",
         help="instead of files: place_case crossings on a collision course, e.g. 5,6 "
         f"(they meet the robot's front at {MEET_TIME:g} s unless it brakes)",
     )
-    p.add_argument("--speeds", default="1,2,3", help="robot speeds, m/s (default 1,2,3)")
-    p.add_argument("--policies", default=DEFAULT_POLICIES, help=f"default {DEFAULT_POLICIES}")
+    p.add_argument(
+        "--speeds", default="1,2,3", help="robot speeds, m/s, comma-separated (default %(default)s)"
+    )
+    p.add_argument(
+        "--policies",
+        default=DEFAULT_POLICIES,
+        help="comma-separated: none, truth, or PREDICTOR/MODE with a predictor's registry "
+        "name (as results and reports name them, e.g. tree/image) and image or ground "
+        "mode (default %(default)s)",
+    )
     p.add_argument(
         "--latency-ms",
         type=non_negative_float,
         help="apply this fixed latency instead of the measured one",
     )
-    p.add_argument("--seed", type=int, default=0, help="environment seed (gait phase)")
+    p.add_argument(
+        "--seed", type=int, default=0, help="environment seed: the gait phase (default %(default)d)"
+    )
     p.add_argument("--out", type=Path, help="write the tables (Markdown) here")
     p.add_argument("--rrd-dir", type=Path, help="record every braking run into this folder")
     p.set_defaults(func=run)
@@ -68,6 +84,7 @@ def case_scenarios(cases: str, speeds: list[float]) -> list[Scenario]:
     from monopic.cases import Case
     from sim.scenario.cases import CasePlacement
     from sim.scenario.families import PlacementError
+    from sim.scenario.files import street_problem
 
     out = []
     for text in cases.split(","):
@@ -91,7 +108,12 @@ def case_scenarios(cases: str, speeds: list[float]) -> list[Scenario]:
             except PlacementError as err:  # e.g. a robot speed beyond the placement's range
                 message = f"--speeds {v:g}: case {int(case)}: {err.field} {err.reason}"
                 raise UserError(message) from None
-            out.append(placement.scenario(name=f"case{int(case)}@{v:g}"))
+            scenario = placement.scenario(name=f"case{int(case)}@{v:g}")
+            problem = street_problem(scenario)  # as a scenario file with these values
+            if problem is not None:
+                message = f"--speeds {v:g}: case {int(case)}: {problem.field} {problem.reason}"
+                raise UserError(message)
+            out.append(scenario)
     return out
 
 
@@ -107,20 +129,26 @@ def file_scenarios(files: list[Path], speeds: list[float], seed: int) -> list[Sc
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim.runs.closed_loop import NO_BRAKE, format_runs, format_table, run_closed_loop, summarise
+    from sim.runs.closed_loop import (
+        NO_BRAKE,
+        check_policy,
+        format_runs,
+        format_table,
+        run_closed_loop,
+        summarise,
+    )
 
     speeds = _numbers(args.speeds, "--speeds")
     policies = [p.strip() for p in args.policies.split(",") if p.strip()]
+    if not policies:
+        raise UserError(f"--policies: no policy in {args.policies!r}")
     for policy in policies:
-        if policy not in ("none", "truth") and policy.count("/") != 1:
-            raise UserError(f"--policies: {policy!r} is not none, truth or PREDICTOR/MODE")
+        try:
+            check_policy(policy)
+        except ValueError as err:
+            raise UserError(f"--policies: {err}") from None
     if NO_BRAKE not in policies:
         policies.insert(0, NO_BRAKE)  # the baseline every other policy is judged against
-    for out in (args.out,):
-        if out is not None and not out.parent.is_dir():
-            raise UserError(f"{out}: its folder {out.parent} does not exist")
-    if args.rrd_dir is not None and not args.rrd_dir.is_dir():
-        raise UserError(f"--rrd-dir {args.rrd_dir}: no such folder")
     if args.cases:
         if args.files:
             raise UserError("give scenario files or --cases, not both")
@@ -130,6 +158,10 @@ def run(args: argparse.Namespace) -> int:
         files = args.files or [FAMILY_FOLDER / f"{name}.toml" for name in NCAP_FAMILIES]
         scenarios = file_scenarios(files, speeds, args.seed)
         source = ", ".join(str(f) for f in files)
+    if args.out is not None:
+        output_file(args.out, "--out")
+    if args.rrd_dir is not None:
+        output_folder(args.rrd_dir, "--rrd-dir")
     outcomes = []
     with tqdm(total=len(scenarios) * len(policies), unit="run") as bar:
         for scenario in scenarios:

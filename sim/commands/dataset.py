@@ -8,6 +8,7 @@ from pathlib import Path
 
 from tqdm import tqdm
 
+from monopic.cli.args import output_folder
 from monopic.errors import UserError
 
 
@@ -23,7 +24,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         "visibility, RLE masks), PNG masks "
         "from MuJoCo's segmentation rendering, per-frame ground truth with case labels, the "
         "pipeline's features in the authors' CSV columns, and a README card. Prints a size "
-        "estimate first. Deterministic for the spec; run it again on the same DIR to resume.",
+        "and time estimate first. Deterministic for the spec; run it again on the same DIR "
+        "to resume.",
     )
     p.add_argument(
         "spec",
@@ -31,22 +33,35 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="SPEC.toml",
         help="a sweep spec: scenarios/datasets/*.toml, scenarios/sweeps/*.toml",
     )
-    p.add_argument("--out", type=Path, required=True, metavar="DIR")
-    p.add_argument("--estimate-only", action="store_true", help="print the size estimate and stop")
+    p.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        metavar="DIR",
+        help="the dataset folder (made as needed; an unfinished one of the same spec resumes)",
+    )
+    p.add_argument(
+        "--estimate-only", action="store_true", help="print the size and time estimate and stop"
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim.dataset.build import build, estimate
+    from sim.dataset.build import build, estimate, estimate_duration, finished_runs
     from sim.dataset.spec import expand, load_spec
 
     spec = load_spec(args.spec)
     out: Path = args.out
-    if not out.parent.is_dir():
-        raise UserError(f"--out {out}: its folder {out.parent} does not exist")
     if args.estimate_only:
-        print(f"size: {estimate(expand(spec), []).text()}")
+        runs = expand(spec)
+        done = finished_runs(out, runs) if out.is_dir() else {}
+        todo = [r for r in runs if r.id not in done]
+        print(f"size: {estimate(runs, list(done.values())).text()}")
+        print(f"time: {estimate_duration(todo, list(done.values())).text()}")
         return 0
+    if out.exists() and not out.is_dir():
+        raise UserError(f"--out {out}: is a file, not a dataset folder")
+    output_folder(out.parent, "--out")
     bars: list[tqdm] = []
 
     def progress(total: int) -> Callable[[int], None]:

@@ -22,10 +22,18 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--judge names the set whose every p50 and p90 is checked against the real scenes' "
         "span (min to max, widened by 20 %).",
     )
-    p.add_argument("specs", nargs="+", type=Path, metavar="SPEC.toml")
+    p.add_argument(
+        "specs", nargs="+", type=Path, metavar="SPEC.toml", help="sweep specs whose walkers to set"
+    )
     p.add_argument("--real", nargs="+", type=Path, required=True, metavar="FILE",
                    help="real tracks, e.g. ../shared/data/eth-ucy-calibration/*.txt")  # fmt: skip
-    p.add_argument("--out", type=Path, required=True, metavar="DIR")
+    p.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        metavar="DIR",
+        help="folder for report.md and its plot (made as needed)",
+    )
     p.add_argument("--judge", help="the spec name to judge (default: the first spec's)")
     p.set_defaults(func=run)
 

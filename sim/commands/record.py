@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 from tqdm import tqdm
 
 from monopic.cases import Case
+from monopic.cli.args import output_file
 from monopic.errors import UserError
 
 if TYPE_CHECKING:  # the simulator is imported when a command runs, not when the CLI starts
@@ -33,7 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "time series and warnings. Open it with `monopic view FILE.rrd`.\n\n" + SCENARIO_HELP,
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("scenario", metavar="SCENARIO")
+    p.add_argument("scenario", metavar="SCENARIO", help="a case, 'crossing' or a scenario file")
     p.add_argument("--rrd", type=Path, help="output file (default recordings/<scenario>.rrd)")
     p.add_argument(
         "--topdown-every",
@@ -89,7 +90,8 @@ def resolve_scenario(text: str, args: argparse.Namespace) -> Scenario:
     """The Scenario named on the command line (see SCENARIO_HELP)."""
     from sim.scenario.cases import CasePlacement, default_crossing
     from sim.scenario.families import PlacementError
-    from sim.scenario.files import load
+    from sim.scenario.files import load, street_problem
+    from sim.scenario.toml_table import show
 
     if text.endswith(".toml") or Path(text).is_file():
         return load(Path(text)).base
@@ -106,7 +108,16 @@ def resolve_scenario(text: str, args: argparse.Namespace) -> Scenario:
     except PlacementError as err:
         flag = f"--{err.field.replace('_', '-')}"
         raise UserError(f"{flag} {err.value:g}: {err.reason}") from None
-    return placement.scenario()
+    scenario = placement.scenario()
+    problem = street_problem(scenario)  # what a scenario file with these values is told
+    if problem is not None:
+        if problem.field == "robot.speed":
+            raise UserError(f"--robot-speed {problem.value:g}: {problem.reason}")
+        raise UserError(
+            f"--distance {args.distance:g} --lateral-offset {args.lateral_offset:g}: "
+            f"{problem.reason}; at {show(problem.value)}"
+        )
+    return scenario
 
 
 def run(args: argparse.Namespace) -> int:
@@ -115,11 +126,7 @@ def run(args: argparse.Namespace) -> int:
     if args.topdown_every < 0:
         raise UserError(f"--topdown-every: must be >= 0, got {args.topdown_every}")
     scenario = resolve_scenario(args.scenario, args)
-    path: Path = args.rrd or DEFAULT_FOLDER / f"{scenario.name}.rrd"
-    if args.rrd is None:
-        path.parent.mkdir(parents=True, exist_ok=True)
-    elif not path.parent.is_dir():
-        raise UserError(f"{path}: its folder {path.parent} does not exist")
+    path = output_file(args.rrd or DEFAULT_FOLDER / f"{scenario.name}.rrd", "--rrd")
     with tqdm(total=scenario.frames, unit="frame", desc=scenario.name) as bar:
         summary = record_run(
             scenario,

@@ -7,15 +7,26 @@ from pathlib import Path
 
 
 def register(sub: argparse._SubParsersAction) -> None:
-    p = sub.add_parser("report", help="write the Markdown report of a sweep's results file")
+    p = sub.add_parser(
+        "report",
+        help="write the Markdown report of a sweep's results file",
+        description="Read a sweep's results file and write report.md with its plots into a "
+        "folder: collision-warning recall and lead time per predictor and family, precision "
+        "and false alarms, near misses warned, case accuracy, position error, found share and "
+        "phi, each saying what it ran on (runs, seeds, frame size, machine, code). Prints the "
+        "headline table.",
+    )
     p.add_argument("results", type=Path, help="results file written by monopic sweep (.jsonl)")
     p.add_argument(
-        "--out", type=Path, help="report folder (default: beside RESULTS, <name>_report/)"
+        "--out",
+        type=Path,
+        help="report folder, made as needed (default: beside RESULTS, <name>_report/)",
     )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
+    from monopic.cli.args import output_folder
     from monopic.errors import UserError
     from sim.analysis.metrics import compute
     from sim.analysis.report import ran_on, write_report
@@ -24,15 +35,40 @@ def run(args: argparse.Namespace) -> int:
     results: Path = args.results
     if not results.is_file():
         raise UserError(f"{results}: no such results file")
+    check_results_file(results)
     rows = list(read_results(results))
     if not rows:
         raise UserError(f"{results}: no finished runs in it yet")
-    out = args.out or results.with_name(f"{results.stem}_report")
-    if out.exists() and not out.is_dir():
-        raise UserError(f"--out {out}: exists and is not a folder")
+    out = output_folder(args.out or results.with_name(f"{results.stem}_report"), "--out")
     metrics = compute(rows)
     report = write_report(metrics, rows, results, out)
     print(report.headline)
     print(f"\n{ran_on(metrics)}")
     print(f"report: {report.markdown} ({len(report.plots)} plots)")
     return 0
+
+
+def check_results_file(path: Path) -> None:
+    """UserError unless the file's first line is a sweep's result line (JSON with an id).
+
+    A CSV or any other file given by mistake is named as such here, rather than by the
+    results reader's advice for a bad line in a sweep's own file."""
+    import json
+
+    from monopic.errors import UserError
+
+    with path.open("rb") as fh:
+        first = fh.readline()
+    if not first.strip():
+        return  # empty: the caller says there are no runs yet
+    try:
+        row = json.loads(first)
+        ok = isinstance(row, dict) and isinstance(row.get("id"), str)
+    except ValueError:
+        ok = False
+    if not ok:
+        shown = first[:40].decode("utf-8", "replace").strip()
+        raise UserError(
+            f"{path}: not a sweep's results file (its first line, {shown!r}, is not a JSON "
+            "result line): give the .jsonl that `monopic sweep` writes"
+        )

@@ -3,15 +3,30 @@
 from __future__ import annotations
 
 import argparse
+import logging
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
 
-from monopic.cli.args import positive_int
+from monopic.cli.args import output_file, positive_int
+
+if TYPE_CHECKING:  # the simulator is imported when the command runs
+    from sim.runs.run_spec import RunSpec
+    from sim.runs.sweep import SweepSpec
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "sweep",
         help="run a scenario sweep (scenarios/sweeps/*.toml) and append results as JSON lines",
+        description="Expand a sweep spec into runs (scenario files and how to sample them, "
+        "scenarios/README.md), render each through every predictor in image and ground mode "
+        "(plus the ground-truth-crop ablation) on local workers or a Ray cluster, and append "
+        "one JSON line per finished run to the results file. Running it again with the same "
+        "--out resumes: runs already there (made by the same code) are skipped. --dry-run "
+        "shows the runs per family and the estimated time first.",
     )
     p.add_argument("spec", type=Path, help="sweep spec, e.g. scenarios/sweeps/demo.toml")
     p.add_argument(
@@ -20,7 +35,12 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--workers", type=positive_int, help="local worker processes (default: all cores)"
     )
-    p.add_argument("--executor", choices=("local", "ray"), default="local")
+    p.add_argument(
+        "--executor",
+        choices=("local", "ray"),
+        default="local",
+        help="local worker processes, or Ray tasks (extra `ray`) (default %(default)s)",
+    )
     p.add_argument("--address", help="Ray cluster address for --executor ray (e.g. host:6379)")
     p.add_argument(
         "--ablation",
@@ -45,17 +65,18 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="if OUT holds runs made by other code, rename it (and its recordings) to "
         "<name>.<code>.jsonl and start over; without it such a file is an error",
     )
-    p.add_argument("--dry-run", action="store_true", help="expand and check the spec, run nothing")
+    p.add_argument(
+        "--dry-run",
+        action="store_true",
+        help="check the spec; print its runs per family and the estimated time; run nothing",
+    )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     from monopic.errors import UserError
-    from sim.runs.code_version import code_version
     from sim.runs.executors import local_executor, ray_executor
-    from sim.runs.result import SCHEMA
-    from sim.runs.results_file import scan
-    from sim.runs.sweep import expand_spec, load_spec, recordings_folder, run_sweep
+    from sim.runs.sweep import load_spec, recordings_folder, run_sweep
 
     if args.address and args.executor != "ray":
         raise UserError("--address is for --executor ray")
@@ -64,35 +85,24 @@ def run(args: argparse.Namespace) -> int:
     spec = load_spec(args.spec)
     out = args.out or Path("recordings") / f"{spec.name}.jsonl"
     if args.dry_run:
-        runs = expand_spec(spec)
-        state = scan(out) if out.exists() else None
-        done = state.ids if state else frozenset()
-        families = sorted({r.family for r in runs})
-        print(f"{spec.path}: {len(runs)} runs in {len(families)} families, "
-              f"{sum(r.id in done for r in runs)} already in {out}")  # fmt: skip
-        other = state.other_code(code_version()) if state else None
-        if other:
-            print(f"{out}: {sum(other.values())} of its runs were made by other code "
-                  "(a sweep would stop; --restart sets them aside)")  # fmt: skip
-        newer = state.newer_schema(SCHEMA) if state else None
-        if newer:
-            print(f"{out}:{newer[0]}: results of schema {newer[1]}, newer than this code's "
-                  f"{SCHEMA} (a sweep would stop; --restart sets them aside)")  # fmt: skip
+        dry_run(spec, out, args)
         return 0
+    output_file(out, "--out")
     if args.executor == "ray":
         executor = ray_executor(args.address)
     else:
         executor = local_executor(args.workers)
-    outcome = run_sweep(
-        spec,
-        out,
-        executor,
-        ablation=args.ablation,
-        limit=args.limit,
-        record=args.record,
-        record_dir=args.recordings,
-        restart=args.restart,
-    )
+    with logs_above_the_bar(args.executor, args.address):
+        outcome = run_sweep(
+            spec,
+            out,
+            executor,
+            ablation=args.ablation,
+            limit=args.limit,
+            record=args.record,
+            record_dir=args.recordings,
+            restart=args.restart,
+        )
     rate = outcome.finished / outcome.seconds if outcome.seconds > 0 else 0.0
     print(
         f"{outcome.finished} runs finished in {outcome.seconds:.0f} s "
@@ -101,7 +111,118 @@ def run(args: argparse.Namespace) -> int:
     )
     print(f"results: {out}  (report: monopic report {out})")
     if args.record != "none":
-        print(f"recordings ({args.record} runs): {recordings_folder(out, args.recordings)}")
+        print(kept_recordings(recordings_folder(out, args.recordings), args.record))
     for run_id, error in outcome.failed[:3]:
         print(f"failed {run_id}:\n{error}")
     return 1 if outcome.failed else 0
+
+
+@contextmanager
+def logs_above_the_bar(executor: str, address: str | None = None) -> Iterator[None]:
+    """Ray's log lines (its start, the code upload, its warnings) written above the sweep's
+    progress bar through tqdm, instead of into the bar's line.
+
+    Ray logs through the 'ray' logger's own stderr handler, which exists once ray is
+    imported, so ray is imported here, before the sweep, as the executor imports it: with
+    the executor's connect timeouts set when joining a cluster (Ray reads them as it
+    loads; sim.runs.executors.RAY_CONNECT_ENV). Lines Ray's C++ core writes to stderr
+    itself bypass logging and are not redirected."""
+    if executor != "ray":
+        yield
+        return
+    from sim.runs.executors import RAY_CONNECT_ENV
+
+    joining = (address or os.environ.get("RAY_ADDRESS", "local")) != "local"
+    added = {k: v for k, v in RAY_CONNECT_ENV.items() if joining and k not in os.environ}
+    os.environ.update(added)
+    try:
+        import ray  # noqa: F401
+    except ImportError:  # the executor says how to install it
+        yield
+        return
+    finally:
+        for key in added:
+            os.environ.pop(key, None)
+    from tqdm.contrib.logging import logging_redirect_tqdm
+
+    with logging_redirect_tqdm(loggers=[logging.getLogger("ray")]):
+        yield
+
+
+def kept_recordings(folder: Path, record: str) -> str:
+    """What the recordings folder holds, once the folders of dropped recordings are gone.
+
+    Each run makes its family's folder before it knows whether its recording is kept;
+    the empty ones are removed here, after the workers have finished."""
+    if folder.is_dir():
+        for sub in sorted(folder.rglob("*"), key=lambda p: len(p.parts), reverse=True):
+            if sub.is_dir() and not any(sub.iterdir()):
+                sub.rmdir()
+        if not any(folder.iterdir()):
+            folder.rmdir()
+    kept = sorted(folder.rglob("*.rrd")) if folder.is_dir() else []
+    which = "missed collisions and false alarms" if record == "failed" else "every run"
+    if not kept:
+        return f"recordings ({which}): none kept"
+    return f"recordings ({which}): {len(kept)} in {folder}"
+
+
+def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
+    """Runs per family, what the results file already holds and the estimated time."""
+    from sim.runs.code_version import code_version
+    from sim.runs.estimate import SWEEP_START_S, bench_frame_seconds, estimate_time
+    from sim.runs.result import SCHEMA
+    from sim.runs.results_file import read_rows, scan
+    from sim.runs.sweep import expand_spec
+
+    runs = expand_spec(spec)
+    state = scan(out) if out.exists() else None
+    done = state.ids if state else frozenset()
+    todo = [r for r in runs if r.id not in done]
+    already = len(runs) - len(todo)
+    limit = f" (--limit {args.limit})" if args.limit is not None else ""
+    if args.limit is not None:
+        todo = todo[: args.limit]
+    todo_ids = {r.id for r in todo}
+    families: dict[str, list[RunSpec]] = {}
+    for r in runs:
+        families.setdefault(r.family, []).append(r)
+    print(f"{spec.path}: {len(runs)} runs in {len(families)} families, {already} already in "
+          f"{out}, {len(todo)} to run{limit}")  # fmt: skip
+    width = max(len("family"), *(len(f) for f in families))
+    print(f"  {'family':<{width}}  {'kind':<9}  {'scale':<5}  runs  to run  frames (at most)")
+    for family, members in sorted(families.items()):
+        first = members[0]
+        left = [r for r in members if r.id in todo_ids]
+        frames = sum(r.scenario.frames for r in left)
+        print(f"  {family:<{width}}  {first.kind:<9}  {first.scale:<5}  {len(members):>4}  "
+              f"{len(left):>6}  {frames:>6}")  # fmt: skip
+    measured = []
+    if state is not None:
+        for row in read_rows(out):
+            timing = row.get("timing") if isinstance(row.get("timing"), dict) else {}
+            wall, frames = timing.get("wall_s"), row.get("frames")
+            if isinstance(wall, int | float) and isinstance(frames, int):
+                measured.append((frames, float(wall)))
+
+    def ablation(r: RunSpec) -> bool:
+        return r.ablation if args.ablation is None else args.ablation
+
+    workers = None if args.executor == "ray" else (args.workers or os.cpu_count() or 1)
+    time = estimate_time(
+        [(r.scenario.frames, bench_frame_seconds(r.scenario.robot.camera, ablation(r)))
+         for r in todo],
+        measured,
+        workers,
+        f"in {out}",
+        SWEEP_START_S,
+    )  # fmt: skip
+    print(f"time: {time.text()}")
+    other = state.other_code(code_version()) if state else None
+    if other:
+        print(f"{out}: {sum(other.values())} of its runs were made by other code "
+              "(a sweep would stop; --restart sets them aside)")  # fmt: skip
+    newer = state.newer_schema(SCHEMA) if state else None
+    if newer:
+        print(f"{out}:{newer[0]}: results of schema {newer[1]}, newer than this code's "
+              f"{SCHEMA} (a sweep would stop; --restart sets them aside)")  # fmt: skip

@@ -18,8 +18,16 @@ def register(sub: argparse._SubParsersAction) -> None:
         "ground plane): DIR/<family>.txt per family and DIR/index.csv (which id is which "
         "run). No rendering: seconds for a whole sweep.",
     )
-    p.add_argument("spec", type=Path, metavar="SPEC.toml")
-    p.add_argument("--out", type=Path, required=True, metavar="DIR")
+    p.add_argument(
+        "spec", type=Path, metavar="SPEC.toml", help="a sweep or dataset spec (scenarios/sweeps)"
+    )
+    p.add_argument(
+        "--out",
+        type=Path,
+        required=True,
+        metavar="DIR",
+        help="folder for the tracks (made as needed)",
+    )
     p.set_defaults(func=run)
 
 

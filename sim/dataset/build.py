@@ -25,8 +25,9 @@ object, 2 in view; RLE masks), frames.csv (one row per image), runs.csv and READ
 (the card: what, how, counts, licence).
 
 Deterministic for a spec: the run seeds (the gait phase) are the sweep's, the renderer
-and the pose models are deterministic on one machine; only the measured-time columns of the features
-(…Ms) differ between invocations.
+and the pose models are deterministic on one machine; only measured times differ between
+invocations: the features' …Ms columns and each run record's `seconds` (which time
+estimates use).
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ import io
 import json
 import math
 import shutil
+import time
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -55,6 +57,12 @@ from monopic.predict.rules import RulePredictor
 from sim.dataset.card import readme
 from sim.dataset.coco import SKELETONS, category, encode_mask, mask_box, select_keypoints
 from sim.dataset.spec import FORMAT_VERSION, JPEG_QUALITY, DatasetRun, DatasetSpec, expand
+from sim.runs.estimate import (
+    DATASET_START_S,
+    TimeEstimate,
+    bench_frame_seconds,
+    estimate_time,
+)
 from sim.runs.loop import Listener, LoopFrame, OnBoard, Progress, run_loop
 from sim.runs.sweep import SweepSpec
 from sim.scenario.spec import CameraSpec, Scenario
@@ -191,6 +199,7 @@ def render_run(
 
     `kept`: a GL context lent from run to run (sim.world.render), else the run makes its own.
     """
+    start = time.perf_counter()
     scenario = run.scenario
     cam = scenario.robot.camera
     for sub in ("images", "masks"):
@@ -227,6 +236,7 @@ def render_run(
         "annotations": writer.annotations,
     }
     record["bytes"] = _run_bytes(out, run.id)
+    record["seconds"] = round(time.perf_counter() - start, 3)  # measured: for time estimates
     write_text_atomically(out / "runs" / f"{run.id}.json", json.dumps(record, default=_plain))
     return record
 
@@ -281,6 +291,18 @@ def estimate(runs: list[DatasetRun], finished: list[dict[str, Any]]) -> SizeEsti
     guess = sum(r.scenario.frames * _frame_bytes(r.scenario.robot.camera) for r in runs)
     per = guess / frames if frames else _frame_bytes(CameraSpec())
     return SizeEstimate(len(runs), frames, per, False)
+
+
+def estimate_duration(todo: list[DatasetRun], finished: list[dict[str, Any]]) -> TimeEstimate:
+    """The time the runs still to render take (one process renders them, one after another):
+    measured on the finished runs' own times, else the benchmark (sim.runs.estimate)."""
+    return estimate_time(
+        [(r.scenario.frames, bench_frame_seconds(r.scenario.robot.camera, False)) for r in todo],
+        [(r["frames"], r.get("seconds", 0.0)) for r in finished],
+        workers=1,
+        measured_where="of this dataset",
+        start_seconds=DATASET_START_S,
+    )
 
 
 def _frame_bytes(cam: CameraSpec) -> float:
@@ -351,6 +373,7 @@ def build(
     size = estimate(runs, list(done.values()))
     report(f"size: {size.text()}")
     report(f"{len(done)} of {len(runs)} runs already finished, {len(todo)} to render")
+    report(f"time: {estimate_duration(todo, list(done.values())).text()}")
     on_frame = progress(sum(r.scenario.frames for r in todo)) if progress and todo else None
     with KeptRenderContext() as kept:
         for run in todo:

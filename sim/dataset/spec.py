@@ -61,7 +61,7 @@ def load_spec(path: Path) -> DatasetSpec:
             "the [grid] form is gone: a dataset spec is a sweep spec; sweep `path.case` and the "
             f"other placement keys of scenarios/datasets/case_grid.toml instead (see {DOC})",
         )  # fmt: skip
-    sweep = parse_sweep_spec(path, data, DOC)
+    sweep = parse_sweep_spec(path, data, DOC, "dataset spec")
     licence = sweep.licence or DEFAULT_LICENCE
     files = _scenario_files(sweep)
     return DatasetSpec(path, sweep.name, sweep.description, licence, sweep, text, files)

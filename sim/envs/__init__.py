@@ -11,12 +11,21 @@ from __future__ import annotations
 import gymnasium
 
 ENV_ID = "monopic/PedestrianCrossing-v0"
+# The longest episode: 60 s, the longest run a scenario may last (scenario files and
+# CasePlacement), at the default 15 Hz policy frequency. The environment truncates each
+# episode at its own scenario's duration, so this TimeLimit never cuts one short; pass
+# max_episode_steps to gymnasium.make for a shorter limit.
+MAX_EPISODE_STEPS = 60 * 15
 
 
 def register_envs() -> None:
     """Register the environment (again importing is harmless)."""
     if ENV_ID not in gymnasium.registry:
-        gymnasium.register(id=ENV_ID, entry_point="sim.envs.crossing:PedestrianCrossingEnv")
+        gymnasium.register(
+            id=ENV_ID,
+            entry_point="sim.envs.crossing:PedestrianCrossingEnv",
+            max_episode_steps=MAX_EPISODE_STEPS,
+        )
 
 
 register_envs()

@@ -4,11 +4,14 @@ A highway-env AbstractEnv (its config dict, road, controlled vehicle and top-dow
 viewer) whose dynamics are exactly World.step: one world step per simulation frame.
 
 - observation: the robot camera's RGB frame, uint8 (H, W, 3) at the scenario camera's size;
-- action: the robot's longitudinal acceleration in m/s^2, shape (1,), bounded by the
-  robot's braking and acceleration limits;
+- action: shape (1,) in [-1, 1], the robot's longitudinal acceleration as a share of its
+  limits: -1 brakes at RobotSpec.max_deceleration, +1 accelerates at max_acceleration,
+  0 holds the speed (linear on each side; gymnasium's check_env wants a normalised,
+  symmetric space); `info["acceleration"]` is the m/s^2 it became;
 - reward: `progress_reward` per metre driven plus `contact_reward` on contact;
 - terminated on contact or once the pedestrian is behind the robot; truncated at the
-  scenario's duration;
+  scenario's duration (registered with max_episode_steps = sim.envs.MAX_EPISODE_STEPS, the
+  longest run a scenario may last, so gymnasium's TimeLimit never cuts an episode first);
 - info: the ground truth (GroundTruth.to_dict()) and the robot's own state; the typed
   records are on `env.unwrapped.world.last`.
 - render modes: "rgb_array" returns the camera frame, "top_down" highway-env's bird's-eye
@@ -17,7 +20,9 @@ viewer) whose dynamics are exactly World.step: one world step per simulation fra
 The config key "scenario" holds a sim.scenario.spec.Scenario (default:
 sim.scenario.cases.default_crossing).
 Each reset draws the world's seed (the gait phase) from the env's RNG, so a seeded reset is
-deterministic. Simulation and policy frequency default to 15 Hz.
+deterministic. Simulation and policy frequency default to 15 Hz; `metadata["render_fps"]`
+is the rate frames are rendered at, one per step (highway-env doubles it, which would
+make a recorded video play at twice the speed).
 
 Headless top-down view: pygame needs a video driver to start; with no display this module
 selects SDL's "dummy" driver. highway-env's EnvViewer then disables drawing altogether
@@ -59,26 +64,41 @@ class CameraObservation(ObservationType):
 
 
 class AccelerationAction(ActionType):
-    """Longitudinal acceleration in m/s^2, within the robot's limits."""
+    """A normalised action in [-1, 1] mapped onto the robot's braking and acceleration limits.
+
+    -1 is the robot's full brake (max_deceleration), +1 its full acceleration
+    (max_acceleration), 0 coasting at constant speed; linear on each side, so an agent
+    sees one symmetric space whatever robot the scenario has.
+    """
 
     def __init__(self, env: AbstractEnv, **kwargs: object) -> None:
         super().__init__(env)
         robot = env.scenario.robot
-        self.low, self.high = -robot.max_deceleration, robot.max_acceleration
-        self.last_action = 0.0
+        self.max_deceleration, self.max_acceleration = (
+            robot.max_deceleration,
+            robot.max_acceleration,
+        )
+        self.last_action = 0.0  # the normalised action, clipped to [-1, 1]
+        self.acceleration = 0.0  # what it means, m/s^2
 
     def space(self) -> spaces.Space:
-        return spaces.Box(self.low, self.high, shape=(1,), dtype=np.float32)
+        return spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
 
     @property
     def vehicle_class(self) -> type[Robot]:
         return Robot
 
+    def to_acceleration(self, action: float) -> float:
+        """m/s^2 for a normalised action (clipped to [-1, 1])."""
+        a = float(np.clip(action, -1.0, 1.0))
+        return a * (self.max_deceleration if a < 0 else self.max_acceleration)
+
     def act(self, action: np.ndarray | float) -> None:
         value = float(np.asarray(action, dtype=float).reshape(-1)[0])
         if not math.isfinite(value):
-            raise ValueError(f"acceleration must be finite, got {value}")
-        self.last_action = float(np.clip(value, self.low, self.high))
+            raise ValueError(f"the action must be finite, got {value}")
+        self.last_action = float(np.clip(value, -1.0, 1.0))
+        self.acceleration = self.to_acceleration(value)
 
 
 class TopDownViewer(EnvViewer):
@@ -91,7 +111,20 @@ class TopDownViewer(EnvViewer):
 
 
 class PedestrianCrossingEnv(AbstractEnv):
-    """See the module docstring."""
+    """A robot drives along a street while a pedestrian crosses or walks; brake or not.
+
+    Observation: the robot camera's RGB frame (H, W, 3) uint8, what the pipeline sees.
+    Action: one number in [-1, 1], the longitudinal acceleration as a share of the
+    robot's limits (-1: full brake, 0: hold speed, +1: full acceleration).
+    Reward: `progress_reward` per metre driven, `contact_reward` on contact.
+    Episode: terminated on contact or once the pedestrian is behind the robot, truncated
+    at the scenario's duration; info holds the ground truth and the robot's state.
+    Config: "scenario" (a sim.scenario.spec.Scenario; default
+    sim.scenario.cases.default_crossing), the frequencies (15 Hz) and highway-env's
+    viewer keys. Render modes: "rgb_array" (the camera frame), "top_down" (highway-env's
+    bird's-eye view), at `metadata["render_fps"]` = the policy frequency.
+    Each step is whole World.steps, the dynamics sweeps and the closed loop use.
+    """
 
     metadata = {"render_modes": ["rgb_array", "top_down"], "render_fps": 15}
 
@@ -99,6 +132,17 @@ class PedestrianCrossingEnv(AbstractEnv):
         self.world: World | None = None
         self._progress = 0.0
         super().__init__(config, render_mode)
+        self.update_metadata()
+
+    def update_metadata(self, video_real_time_ratio: int = 2) -> None:
+        """render_fps = the rate frames are rendered at: one per step (policy frequency), or
+        one per simulation frame while highway-env's own video wrapper records them.
+
+        highway-env multiplies it by `video_real_time_ratio` (a video would play at twice
+        the speed) and writes it into the class's dict; here it is the true rate, and the
+        instance's own (ratio ignored)."""
+        steps = "simulation_frequency" if self._record_video_wrapper else "policy_frequency"
+        self.metadata = {**type(self).metadata, "render_fps": self.config[steps]}
 
     @classmethod
     def default_config(cls) -> dict:
@@ -159,7 +203,9 @@ class PedestrianCrossingEnv(AbstractEnv):
         frames = int(self.config["simulation_frequency"] // self.config["policy_frequency"])
         start = self.world.robot.world_pose
         for frame in range(frames):
-            self.world.step(1.0 / self.config["simulation_frequency"], self.action_type.last_action)
+            self.world.step(
+                1.0 / self.config["simulation_frequency"], self.action_type.acceleration
+            )
             self.steps += 1
             if frame < frames - 1:
                 self._automatic_rendering()
@@ -196,7 +242,8 @@ class PedestrianCrossingEnv(AbstractEnv):
             "time": step.time,
             "speed": step.ego.speed,
             "crashed": step.truth.contact,
-            "action": float(self.action_type.last_action),
+            "action": float(self.action_type.last_action),  # normalised, [-1, 1]
+            "acceleration": float(self.action_type.acceleration),  # m/s^2
             "rewards": self._rewards(action),
             "pedestrian_passed": self._pedestrian_passed(),
             "truth": step.truth.to_dict(),

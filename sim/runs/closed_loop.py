@@ -39,7 +39,7 @@ import numpy as np
 
 from monopic.pipeline import Pipeline
 from monopic.predict.base import Mode
-from monopic.predict.registry import make_predictor
+from monopic.predict.registry import make_predictor, predictor_names
 from sim.recording.sim_recording import SimRecording
 from sim.runs.loop import Listener, LoopEnd, LoopFrame, OnBoard, Progress, run_loop
 from sim.scenario.spec import Scenario
@@ -119,13 +119,31 @@ class LatencyBrake:
 POLICY = "policy"  # the on-board pipeline's name in the loop
 
 
+def policy_choices() -> str:
+    """The policies there are, as the error and --help say them."""
+    names = "|".join(predictor_names())
+    modes = "|".join(m.value for m in Mode)
+    return f"{NO_BRAKE}, {ORACLE} or PREDICTOR/MODE ({names})/({modes})"
+
+
+def check_policy(policy: str) -> None:
+    """ValueError naming the policies there are unless `policy` is one of them.
+
+    Policies are the keys results and reports use ("rules/image"), predictors by their
+    registry names; checked before any run, not when the first run of it starts."""
+    if policy in (NO_BRAKE, ORACLE):
+        return
+    name, slash, mode = policy.partition("/")
+    if not slash or name not in predictor_names() or mode not in {m.value for m in Mode}:
+        raise ValueError(f"{policy!r} is not a policy: use {policy_choices()}")
+
+
 def policy_pipeline(scenario: Scenario, policy: str) -> Pipeline:
     """A pipeline whose primary (only) predictor is the policy's, e.g. 'rules/ground'."""
     from sim.runs.pipelines import scenario_pipeline
 
+    check_policy(policy)
     name, _, mode = policy.partition("/")
-    if mode not in {m.value for m in Mode}:
-        raise ValueError(f"policy {policy!r}: expected 'none', 'truth' or PREDICTOR/MODE")
     return scenario_pipeline(scenario, [make_predictor(name, Mode(mode))])
 
 

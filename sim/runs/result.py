@@ -183,11 +183,29 @@ class RunResult:
                 f"({'written by newer code: update this checkout' if newer else 'rerun the sweep'}"
                 " or rerun with `monopic sweep SPEC --restart`)"
             )
-        return from_plain(cls, data, where)
+        return _current_names(from_plain(cls, data, where))
 
     def dumps(self) -> str:
         """One compact JSON line (no newline)."""
         return json.dumps(self.to_json(), separators=(",", ":"))
+
+
+# Predictor names that results written by older code use, and the registry's name for each
+# (the ID3 tree called itself "id3-tree" until the registry's "tree" became the one name).
+OLD_PREDICTOR_NAMES = {"id3-tree": "tree"}
+
+
+def current_key(key: str) -> str:
+    """A decision key ("id3-tree/image") in today's vocabulary ("tree/image")."""
+    name, slash, mode = key.partition("/")
+    return f"{OLD_PREDICTOR_NAMES.get(name, name)}{slash}{mode}"
+
+
+def _current_names(result: RunResult) -> RunResult:
+    """Old lines read in today's predictor names, so a report never shows both."""
+    for columns in result.pipelines.values():
+        columns.decisions = {current_key(k): v for k, v in columns.decisions.items()}
+    return result
 
 
 # -- the generic round trip -------------------------------------------------------------

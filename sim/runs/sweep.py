@@ -8,10 +8,10 @@ A sweep spec (scenarios/sweeps/*.toml, documented in scenarios/README.md):
     [[include]]
     files = ["../families/car/*.toml"]   # globs, relative to the spec
     sampling = "random"             # "file" (as each file says), "base", "grid", "random"
-    runs = 3                        # random draws per file
+    runs = 3                        # random draws per file (random sampling only)
     seed = 7
     [include.parameters]            # add or replace sweep parameters of those files
-    "robot.speed" = [0.0, 8.33]
+    "robot.speed" = [0.0, 8.33]     # (with "base": a grid over these alone)
 
 Expansion is deterministic: a run's id is the file's name, its draw number and a digest
 of the complete scenario, and its seed derives from the same, so re-expanding the spec
@@ -42,6 +42,7 @@ from sim.scenario.files import (
     ScenarioFileError,
     Sweep,
     expand,
+    is_scenario_file,
     load,
     parse_parameters,
 )
@@ -80,8 +81,15 @@ def load_spec(path: Path | str) -> SweepSpec:
     return parse_spec(path, data)
 
 
-def parse_spec(path: Path, data: Mapping[str, Any], doc: str = "scenarios/README.md") -> SweepSpec:
+def parse_spec(
+    path: Path, data: Mapping[str, Any], doc: str = "scenarios/README.md", what: str = "sweep spec"
+) -> SweepSpec:
     """Check a sweep spec's data (keys SPEC_KEYS); `doc` is where the keys are documented."""
+    if is_scenario_file(data):
+        raise UserError(
+            f"{path}: this is a scenario file, not a {what} (a {what} lists scenario files "
+            f"under [[include]], see {doc}): record it alone with `monopic record {path}`"
+        )
     top = TomlTable(path, "", data, doc)
     name = top.slug("name")
     description = top.text("description", "")
@@ -105,7 +113,12 @@ def parse_spec(path: Path, data: Mapping[str, Any], doc: str = "scenarios/README
         sampling = entry.text("sampling", "file", INCLUDE_SAMPLING)
         runs = entry.integer("runs", None, low=1)
         seed = entry.integer("seed", None)
-        parameters = parse_parameters(entry, need_steps=sampling == "grid")
+        for key, value in (("runs", runs), ("seed", seed)):
+            if value is not None and sampling in ("base", "grid"):
+                raise entry.error(
+                    key, value, f'draws at random only: sampling = "{sampling}" would ignore it'
+                )
+        parameters = parse_parameters(entry, need_steps=sampling in ("grid", "base"))
         entry.done()
         includes.append(Include(tuple(files), sampling, runs, seed, parameters))
     top.done()
@@ -121,9 +134,12 @@ def _glob(base: Path, pattern: str) -> list[Path]:
 
 
 def _effective_sweep(include: Include, file: ScenarioFile) -> Sweep | None:
-    """The file's sweep as the include entry modifies it (None: just the base scenario)."""
+    """The file's sweep as the include entry modifies it (None: just the base scenario).
+
+    "base" drops the file's own sweep: one run at the file's values, or with
+    [include.parameters] a grid over those parameters only (never silently dropped)."""
     if include.sampling == "base":
-        return None
+        return Sweep("grid", dict(include.parameters)) if include.parameters else None
     own = file.sweep
     params = dict(own.parameters) if own else {}
     params.update(include.parameters)

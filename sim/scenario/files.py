@@ -21,6 +21,7 @@ from typing import Any
 import numpy as np
 
 from monopic.cases import Case
+from monopic.errors import UserError
 from sim.scenario.cases import PLACEMENT_FIELDS, CasePlacement
 from sim.scenario.families import (
     BODIES,
@@ -67,6 +68,22 @@ MAX_GRID_RUNS = 100_000
 
 
 ScenarioFileError = FieldError  # the name callers of this module know
+
+# Top-level keys by which a scenario file and a sweep spec tell themselves apart, so that
+# one given for the other is named for what it is, not for its first unknown key.
+SCENARIO_FILE_KEYS = ("path", "pedestrian", "robot", "scene", "sweep", "family", "kind",
+                      "scale", "duration", "fps", "horizon", "seed")  # fmt: skip
+SWEEP_SPEC_KEY = "include"
+
+
+def is_scenario_file(data: Mapping[str, Any]) -> bool:
+    """The data of a scenario file (it has a scenario's tables and no [[include]])."""
+    return SWEEP_SPEC_KEY not in data and any(k in data for k in SCENARIO_FILE_KEYS)
+
+
+def is_sweep_spec(data: Mapping[str, Any]) -> bool:
+    """The data of a sweep or dataset spec (it has [[include]] and no [path])."""
+    return SWEEP_SPEC_KEY in data and "path" not in data
 
 
 # -- sweeps ---------------------------------------------------------------------------
@@ -252,6 +269,11 @@ def load(path: Path | str) -> ScenarioFile:
     """Read and validate one scenario file (its base scenario and every sweep value)."""
     path = Path(path)
     _, data = read_toml(path, "scenario file")
+    if is_sweep_spec(data):
+        raise UserError(
+            f"{path}: this is a sweep spec, not a scenario file (it lists scenario files "
+            f"under [[include]]): run it with `monopic sweep {path}`"
+        )
     top = TomlTable(path, "", data)
     sweep_table = top.table("sweep") if top.has("sweep") else None
     data.pop("sweep", None)  # the base scenario is the file without its sweep
@@ -612,16 +634,30 @@ def _parked_cars(
 
 def _check_on_street(path: Path, s: Scenario) -> None:
     """The robot stays on its road and the pedestrian on the street for the whole run."""
+    problem = street_problem(s)
+    if problem is not None:
+        raise ScenarioFileError(path, problem.field, problem.value, problem.reason)
+
+
+def street_problem(s: Scenario) -> PlacementError | None:
+    """Why the scenario leaves its street (robot off its road or past its end, pedestrian
+    off the street, robot faster than its own limit), None when it does not.
+
+    The whole-scenario checks of a scenario file, shared with scenarios made on the
+    command line (record, closed-loop --cases) so that both accept the same values."""
     road = s.scene.road
     y_right, y_left = road.edges
+    if s.robot.speed > s.robot.max_speed:
+        return PlacementError(
+            "robot.speed", s.robot.speed, f"must be <= {s.robot.max_speed:g} m/s (its max_speed)"
+        )
     if not (y_right <= -s.robot.width / 2 and s.robot.width / 2 <= y_left):
-        raise ScenarioFileError(
-            path, "scene.road.center_y", road.center_y, "the robot (at y = 0) is not on the road"
+        return PlacementError(
+            "scene.road.center_y", road.center_y, "the robot (at y = 0) is not on the road"
         )
     end = s.robot.speed * s.duration + s.robot.length / 2
     if end > road.length / 2:
-        raise ScenarioFileError(
-            path,
+        return PlacementError(
             "robot.speed",
             s.robot.speed,
             f"the robot would drive off the end of the road within the run "
@@ -633,10 +669,10 @@ def _check_on_street(path: Path, s: Scenario) -> None:
     for t in times:
         x, y = ped.state(t).position
         if not (x0 <= x <= x1 and y0 <= y <= y1):
-            raise ScenarioFileError(
-                path,
+            return PlacementError(
                 "path",
                 {"t": round(t, 3), "x": round(float(x), 2), "y": round(float(y), 2)},
                 f"the pedestrian's path leaves the street (x in [{x0:g}, {x1:g}] m, "
                 f"y in [{y0:.2f}, {y1:.2f}] m)",
             )
+    return None

@@ -9,6 +9,7 @@ rejects the keys nobody asked for (typos). A mistake is one FieldError line,
 
 from __future__ import annotations
 
+import difflib
 import math
 import tomllib
 from collections.abc import Mapping
@@ -93,10 +94,23 @@ class TomlTable:
         self.seen.add(key)
         if key not in self.data:
             if default is MISSING:
+                typo = self._misspelt(key)
+                if typo is not None:  # name the real mistake, not only its consequence
+                    raise self.error(
+                        typo,
+                        self.data[typo],
+                        f"unknown key, and {self.field(key)} is missing: did you mean {key!r}?",
+                    )
                 need = f"required: {expected}" if expected else "required"
                 raise FieldError(self.file, self.field(key), MISSING, f"missing ({need})")
             return default
         return self.data[key]
+
+    def _misspelt(self, key: str) -> str | None:
+        """A key of the table nobody asked for that looks like `key` (e.g. file for files)."""
+        unseen = [k for k in self.data if k not in self.seen]
+        close = difflib.get_close_matches(key, unseen, n=1, cutoff=0.6)
+        return close[0] if close else None
 
     def number(
         self,
@@ -238,4 +252,8 @@ class TomlTable:
             if key not in self.seen:
                 known = ", ".join(sorted(self.seen)) or "none"
                 see = f"; see {self.doc}" if self.doc else ""
-                raise self.error(key, self.data[key], f"unknown key (known here: {known}{see})")
+                close = difflib.get_close_matches(key, sorted(self.seen), n=1, cutoff=0.6)
+                hint = f"did you mean {close[0]!r}? " if close else ""
+                raise self.error(
+                    key, self.data[key], f"unknown key ({hint}known here: {known}{see})"
+                )

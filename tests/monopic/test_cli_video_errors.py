@@ -53,3 +53,38 @@ def test_ground_mode_needs_camera_geometry(tmp_path):
     w.release()
     r = run(str(clip), "--mode", "ground", cwd=tmp_path)
     assert r.returncode == 2 and "--fov" in r.stderr
+
+
+def tiny_clip(folder):
+    import cv2
+    import numpy as np
+
+    clip = folder / "c.mp4"
+    w = cv2.VideoWriter(str(clip), cv2.VideoWriter_fourcc(*"mp4v"), 15, (64, 48))
+    for _ in range(3):
+        w.write(np.zeros((48, 64, 3), np.uint8))
+    w.release()
+    return clip
+
+
+def test_no_output_asked_for_is_refused_before_any_frame(tmp_path):
+    """It used to run the whole video and write nothing, saying only a frame count."""
+    clip = tiny_clip(tmp_path)
+    r = run(str(clip), cwd=tmp_path)
+    assert r.returncode == 2 and r.stdout == ""
+    (line,) = r.stderr.strip().splitlines()
+    assert "nothing to write: give --out VIDEO.mp4, --csv FRAMES.csv and/or --rrd" in line
+
+
+def test_outputs_go_into_folders_made_as_needed(tmp_path):
+    """The one rule for output paths: a missing folder is created (mkdir -p)."""
+    clip = tiny_clip(tmp_path)
+    out = tmp_path / "new" / "deeper" / "frames.csv"
+    r = run(str(clip), "--csv", str(out), cwd=tmp_path)
+    assert r.returncode == 0, r.stderr
+    assert out.is_file() and out.read_text().startswith("frameNumber,")
+    (tmp_path / "file").write_text("x")
+    r = run(str(clip), "--csv", str(tmp_path / "file" / "frames.csv"), cwd=tmp_path)
+    assert r.returncode == 2
+    (line,) = r.stderr.strip().splitlines()
+    assert line.endswith(f"--csv {tmp_path / 'file'}: a file is in the way of this folder")

@@ -105,3 +105,41 @@ def test_path_projection_finds_the_conflict_point():
     path = project_path(f, p, zone, length=4.0, steps=16)
     assert path.conflict_index is not None
     assert 2.0 <= path.conflict_time <= 3.0  # foot reaches u = 468 after 2.32 s
+
+
+def test_every_predictor_calls_itself_by_its_registry_name():
+    """Results, reports and closed-loop --policies all say '<registry name>/<mode>'."""
+    from monopic.errors import UserError
+    from monopic.predict.registry import make_predictor, predictor_names
+
+    assert {"rules", "tree", "constant-velocity"} <= set(predictor_names())
+    built = 0
+    for name in predictor_names():
+        for mode in Mode:
+            try:
+                predictor = make_predictor(name, mode)
+            except UserError as err:  # the shipped tree is an image-mode tree
+                assert name == "tree" and "ground mode" in str(err)
+                continue
+            assert predictor.name == name and predictor.mode is mode
+            built += 1
+    assert built >= 5
+
+
+def liar(mode, model):
+    """A plug-in factory whose predictor calls itself by another name."""
+    return RulePredictor(mode)
+
+
+def test_a_predictor_named_otherwise_than_its_entry_point_is_refused(monkeypatch):
+    from importlib.metadata import EntryPoint
+
+    from monopic.errors import UserError
+    from monopic.predict import registry
+
+    entry = EntryPoint("mine", f"{__name__}:liar", registry.PREDICTOR_GROUP)
+    monkeypatch.setattr(registry, "_registered", lambda: {"mine": entry})
+    with pytest.raises(UserError, match="'mine' .* calls itself 'rules'"):
+        registry.make_predictor("mine", Mode.IMAGE)
+    with pytest.raises(UserError, match="unknown predictor 'id3-tree': choose from mine"):
+        registry.make_predictor("id3-tree", Mode.IMAGE)

@@ -84,11 +84,19 @@ def test_braking_on_the_ground_mode_warning_avoids_contacts():
     ("argv", "expected"),
     [
         (["--cases", "7"], "case 7 (toward) does not cross the path"),
-        (["--cases", "5", "--policies", "brake"], "'brake' is not none, truth or PREDICTOR/MODE"),
+        (["--cases", "5", "--policies", "brake"], "'brake' is not a policy: use none, truth"),
+        (["--cases", "5", "--policies", "id3-tree/image"], "(constant-velocity|rules|tree)"),
+        (["--cases", "5", "--policies", "rules/sky"], "'rules/sky' is not a policy"),
         (["--cases", "5", "--speeds", "fast"], "--speeds: expected numbers"),
     ],
 )
-def test_closed_loop_command_rejects_bad_input_in_one_line(capsys, argv, expected):
+def test_closed_loop_command_rejects_bad_input_in_one_line(capsys, monkeypatch, argv, expected):
+    import sim.runs.closed_loop
+
+    def no_run(*args, **kwargs):
+        raise AssertionError("a run started before the input was checked")
+
+    monkeypatch.setattr(sim.runs.closed_loop, "run_closed_loop", no_run)
     assert main(["closed-loop", *argv]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and expected in err

@@ -196,13 +196,14 @@ def _files(folder: Path) -> dict[str, bytes]:
 
 
 def comparable(folder: Path) -> dict[str, object]:
-    """A dataset's files less what the features' measured times move: the features and
-    the byte counts (a time's digits change a features file's size)."""
+    """A dataset's files less what the measured times move: the features, the byte counts
+    (a time's digits change a features file's size) and each run's seconds."""
     out: dict[str, object] = {}
     for name, data in _files(folder).items():
         if name.startswith("runs/"):
             record = json.loads(data)
             record.pop("bytes")
+            record.pop("seconds")
             out[name] = record
         elif name == "runs.csv":
             out[name] = [row[:-1] for row in csv.reader(data.decode().splitlines())]

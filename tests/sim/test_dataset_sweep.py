@@ -122,7 +122,7 @@ def test_a_spec_without_includes_is_a_one_line_error_through_the_command(
     out = str(tmp_path / "out")
     assert main(["dataset", str(typo), "--out", out]) == 2
     err = capsys.readouterr().err.strip()
-    assert f"{typo}: includes = [" in err and "unknown key (known here: " in err
+    assert f"{typo}: includes = [" in err and "unknown key (did you mean 'include'? known" in err
     assert "\n" not in err
     assert main(["dataset", str(empty), "--out", out]) == 2
     err = capsys.readouterr().err.strip()

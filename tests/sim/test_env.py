@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import replace
 
 import gymnasium as gym
@@ -32,15 +33,62 @@ def make(render_mode: str = "rgb_array", **config: object) -> PedestrianCrossing
     return env.unwrapped  # type: ignore[return-value]
 
 
-@pytest.mark.filterwarnings("ignore:.*symmetric and normalized space")
-def test_passes_the_gymnasium_env_checker() -> None:
+def test_passes_the_gymnasium_env_checker_without_a_warning() -> None:
     env = make()
     try:
         assert env.observation_space.shape == (90, 160, 3)
-        assert env.action_space.shape == (1,)
-        check_env(env)  # includes the render check of every declared mode
+        assert env.action_space == gym.spaces.Box(-1.0, 1.0, shape=(1,), dtype=np.float32)
+        with warnings.catch_warnings(record=True) as caught:
+            warnings.simplefilter("always")
+            check_env(env)  # includes the render check of every declared mode
+        assert [str(w.message) for w in caught] == []
     finally:
         env.close()
+
+
+def test_the_normalised_action_maps_onto_the_robots_limits() -> None:
+    env = make()
+    try:
+        env.reset(seed=0)
+        robot = env.scenario.robot
+        act = env.action_type
+        brake, accelerate = robot.max_deceleration, robot.max_acceleration
+        cases = [(-1.0, -brake), (-0.5, -brake / 2), (0.0, 0.0), (0.5, accelerate / 2),
+                 (1.0, accelerate), (-3.0, -brake), (7.0, accelerate)]  # fmt: skip
+        for action, expected in cases:
+            assert act.to_acceleration(action) == pytest.approx(expected)
+        _, _, _, _, info = env.step(np.array([-0.25], dtype=np.float32))
+        assert info["action"] == -0.25
+        assert info["acceleration"] == pytest.approx(-0.25 * robot.max_deceleration)
+        assert info["speed"] == pytest.approx(robot.speed - 0.25 * robot.max_deceleration / 15)
+        with pytest.raises(ValueError, match="the action must be finite"):
+            env.step(np.array([np.nan], dtype=np.float32))
+    finally:
+        env.close()
+
+
+def test_render_fps_is_the_step_rate_and_episodes_have_a_registered_limit() -> None:
+    """gymnasium's RecordVideo plays at render_fps: highway-env's doubled rate played the
+    episode at twice its speed."""
+    from sim.envs import MAX_EPISODE_STEPS
+    from sim.scenario.cases import PLACEMENT_FIELDS
+
+    assert gym.spec(ENV_ID).max_episode_steps == MAX_EPISODE_STEPS
+    assert PLACEMENT_FIELDS["duration"].metadata["high"] * 15 == MAX_EPISODE_STEPS
+    for policy_frequency in (15, 5):
+        wrapped = gym.make(
+            ENV_ID,
+            config={"scenario": small(default_crossing()), "policy_frequency": policy_frequency},
+            render_mode="rgb_array",
+        )
+        try:
+            assert wrapped.metadata["render_fps"] == policy_frequency
+            wrapped.reset(seed=0)
+            assert wrapped.metadata["render_fps"] == policy_frequency
+            assert wrapped.spec.max_episode_steps == MAX_EPISODE_STEPS
+        finally:
+            wrapped.close()
+    assert PedestrianCrossingEnv.metadata["render_fps"] == 15  # the class's own is untouched
 
 
 def test_registered_under_its_id_as_a_highway_env() -> None:
@@ -69,7 +117,7 @@ def rollout(seed: int, actions: list[float]) -> list[tuple]:
 
 
 def test_deterministic_for_a_seed() -> None:
-    actions = [0.5, 0.0, -1.0, -2.0, 1.0]
+    actions = [0.2, 0.0, -0.125, -0.25, 0.3]
     a, b, c = rollout(7, actions), rollout(7, actions), rollout(8, actions)
     for (oa, ra, ta, ua, ia), (ob, rb, tb, ub, ib) in zip(a, b, strict=True):
         assert np.array_equal(oa, ob)
@@ -106,7 +154,7 @@ def test_contact_terminates_with_a_penalty_and_braking_avoids_it() -> None:
         terminated = truncated = False
         steps = 0
         while not (terminated or truncated):
-            _, reward, terminated, truncated, info = env.step(np.array([-8.0], dtype=np.float32))
+            _, reward, terminated, truncated, info = env.step(np.array([-1.0], dtype=np.float32))
             steps += 1
         assert truncated and not terminated and not info["crashed"]
         assert steps == sc.frames

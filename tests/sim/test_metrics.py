@@ -243,3 +243,15 @@ def test_nuisance_warnings_and_flicker_count_episodes_off_any_collision_course()
     assert on_course.nuisance_onsets == 0 and on_course.episodes == 1
     quiet = judge_run(row("q", [None] * 20, [0] * 20, kind="near-miss"), KEY)
     assert (quiet.episodes, quiet.nuisance_onsets, quiet.flickers) == (0, 0, 0)
+
+
+def test_every_predictor_and_mode_has_its_own_colour_in_the_plots() -> None:
+    """Histograms and bars have no line style: rules/image and rules/ground must differ."""
+    from sim.analysis.plots import style
+    from sim.runs.pipelines import PREDICTORS
+
+    keys = [f"{name}/{mode}" for name, mode in PREDICTORS] + ["tree/ground"]
+    colours = [style(key)["color"] for key in keys]
+    assert len(set(colours)) == len(keys)
+    assert style("gtcrop:rules/image")["color"] == style("rules/image")["color"]
+    assert style("mine/image")["color"] == style("mine/image")["color"] not in colours

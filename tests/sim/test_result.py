@@ -113,6 +113,20 @@ def test_a_field_added_later_loads_with_its_default_from_older_lines() -> None:
     assert back.recording is None and back.timing.sim_ms == []
 
 
+def test_lines_of_older_code_read_in_the_registry_vocabulary() -> None:
+    """The ID3 tree was 'id3-tree' in results before its registry name 'tree' became the
+    only name: such lines read as tree/image, so no report shows both names."""
+    line = every_field_set().to_json()
+    decisions = line["pipelines"]["main"]["decisions"]
+    decisions["id3-tree/image"] = decisions["rules/image"]
+    back = RunResult.from_json(line)
+    assert sorted(back.pipelines["main"].decisions) == ["rules/image", "tree/image"]
+    assert (
+        back.pipelines["main"].decisions["tree/image"]
+        == back.pipelines["main"].decisions["rules/image"]
+    )
+
+
 @pytest.mark.parametrize(
     ("edit", "message"),
     [

@@ -238,7 +238,7 @@ def test_run_recording_starts_on_the_first_image_framed_on_it(tmp_path):
 
 
 def test_predictor_colours_are_fixed_and_never_the_truths():
-    keys = ["rules/image", "rules/ground", "id3-tree/image", "constant-velocity/ground", "x/y"]
+    keys = ["rules/image", "rules/ground", "tree/image", "constant-velocity/ground", "x/y"]
     colours = [predictor_colour(k) for k in keys]
     assert len(set(colours[:4])) == 4 and (0, 210, 255) not in colours
     assert predictor_colour("x/y") == colours[-1]  # stable for unknown keys too

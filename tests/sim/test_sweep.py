@@ -269,14 +269,24 @@ def test_ray_executor_gives_the_local_executor_results(tmp_path: Path) -> None:
 def test_sweep_and_report_commands(
     spec_path: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    out = tmp_path / "cli.jsonl"
+    out = tmp_path / "new" / "cli.jsonl"  # folders are made as needed (README)
     assert main(["sweep", str(spec_path), "--out", str(out), "--dry-run"]) == 0
     assert "3 runs in 1 families, 0 already" in capsys.readouterr().out
     code = main(["sweep", str(spec_path), "--out", str(out), "--workers", "2", "--no-ablation"])
     assert code == 0
     assert len(out.read_text().splitlines()) == 3
     assert all("gtcrop" not in r["pipelines"] for r in read_rows(out))
-    report_dir = tmp_path / "report"
+    kept = [r["recording"] for r in read_rows(out) if r["recording"]]
+    printed = capsys.readouterr().out
+    folder = out.parent / "cli_rrd"
+    if kept:
+        assert (
+            f"recordings (missed collisions and false alarms): {len(kept)} in {folder}" in printed
+        )
+    else:
+        assert "recordings (missed collisions and false alarms): none kept" in printed
+    assert not [p for p in out.parent.rglob("*") if p.is_dir() and not any(p.iterdir())]
+    report_dir = tmp_path / "deep" / "er" / "report"
     assert main(["report", str(out), "--out", str(report_dir)]) == 0
     printed = capsys.readouterr().out
     assert "rules/image" in printed and "report.md" in printed

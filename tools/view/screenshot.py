@@ -6,7 +6,8 @@
 What works here (2 cores, no GPU, no display): the native viewer of rerun-sdk 0.41 in its
 headless mode (`rerun --headless`: an offscreen egui harness, no window, no X server)
 on Mesa's lavapipe, a software Vulkan driver (Debian: `apt-get install -y
-mesa-vulkan-drivers`), driven over gRPC by rerun's ViewerClient: open the file, move the
+mesa-vulkan-drivers`; without a Vulkan driver the tool stops with one line saying so),
+driven over gRPC by rerun's ViewerClient: open the file, move the
 time cursor to each `--at` (seconds on the `time` timeline, paused; `end` for the last
 frame), save a screenshot (of the whole viewer or of one `--view`). It prints what each
 view reported as failing to draw. About 5 s for a few screenshots. By hand:
@@ -71,6 +72,24 @@ def rerun_executable() -> str:
     return str(binary)
 
 
+# Where the Vulkan loader looks for drivers (ICD manifests) when no variable names them.
+VULKAN_ICD_DIRS = ("/usr/share/vulkan/icd.d", "/etc/vulkan/icd.d", "/usr/local/share/vulkan/icd.d")
+NO_VULKAN = (
+    "no Vulkan driver found: rerun's headless viewer draws with Vulkan and finds no graphics "
+    "adapter without one; install Mesa's software driver (lavapipe): apt-get install -y "
+    "mesa-vulkan-drivers (Debian, Ubuntu), or use --web"
+)
+
+
+def vulkan_drivers(env: dict[str, str] | os._Environ[str] = os.environ) -> list[Path]:
+    """The Vulkan driver manifests the loader would find (VK_DRIVER_FILES or
+    VK_ICD_FILENAMES when set, as the loader reads them, else its standard folders)."""
+    listed = env.get("VK_DRIVER_FILES") or env.get("VK_ICD_FILENAMES")
+    if listed:
+        return [Path(p) for p in listed.split(os.pathsep) if Path(p).is_file()]
+    return sorted(p for d in VULKAN_ICD_DIRS for p in Path(d).glob("*.json"))
+
+
 def port_free(port: int) -> bool:
     """Nothing listens on 127.0.0.1:`port` (else a client would talk to another viewer)."""
     with socket.socket() as sock:
@@ -133,6 +152,22 @@ def view_id(client: ViewerClient, name: str | None) -> str | None:
     if name not in views:
         raise SystemExit(f"no view {name!r}; the views: {', '.join(sorted(views))}")
     return views[name]
+
+
+def last_error(log: Path) -> str:
+    """The viewer log's last line that reads like an error, for a one-line message."""
+    try:
+        lines = log.read_text(errors="replace").splitlines()
+    except OSError:
+        return "no viewer log"
+    panics = [ln.strip() for ln in lines if "panicked at" in ln]  # before its backtrace
+    errors = panics or [ln.strip() for ln in lines if "ERROR" in ln or "error:" in ln]
+    if not errors:
+        return "the viewer logged no error"
+    line = errors[-1]
+    if "adapter" in line.lower():
+        return f"the viewer found no graphics adapter ({NO_VULKAN.split('; ', 1)[1]})"
+    return f"the viewer said: {line[:200]}"
 
 
 def small_copy(png: Path, width: int) -> Path:
@@ -205,16 +240,24 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--web", action="store_true", help="the web viewer in headless Chromium")
     args = p.parse_args(argv)
 
+    if not args.rrd.is_file():
+        sys.exit(f"screenshot.py: {args.rrd}: no such recording")
     args.out.mkdir(parents=True, exist_ok=True)
     if args.web:
         print(web_screenshot(args.rrd, args.out, args.size, args.port))
         return 0
+    if not vulkan_drivers():
+        sys.exit(f"screenshot.py: {NO_VULKAN}")
     if not port_free(args.port):
         sys.exit(f"port {args.port} is in use (another viewer?): pick one with --port")
-    viewer = start_viewer(args.port, args.size, args.out / "viewer.log")
+    log = args.out / "viewer.log"
+    viewer = start_viewer(args.port, args.size, log)
     try:
-        client = connect(args.port, viewer)
-        end_ns = open_recording(client, args.rrd)
+        try:
+            client = connect(args.port, viewer)
+            end_ns = open_recording(client, args.rrd)
+        except (RuntimeError, TimeoutError, ConnectionError) as err:
+            sys.exit(f"screenshot.py: {err}; {last_error(log)} (whole log: {log})")
         for at in args.at or ["end"]:
             ns = end_ns if at == "end" else round(float(at) * 1e9)
             client.set_time("time", duration=ns * 1e-9, play_state="paused")

@@ -1,0 +1,302 @@
+"""Command-line mistakes a newcomer makes: one line that points at the real mistake."""
+
+from __future__ import annotations
+
+import os
+import tomllib
+from pathlib import Path
+
+import pytest
+
+from monopic.cli.main import main
+from tests.paths import SCENARIOS
+
+CASE5 = SCENARIOS / "cases" / "case5_perpendicular_right.toml"
+DEMO = SCENARIOS / "sweeps" / "demo.toml"
+
+
+def one_line_error(capsys: pytest.CaptureFixture[str]) -> str:
+    err = capsys.readouterr().err.strip()
+    assert err and "\n" not in err, err
+    return err
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["sweep", str(CASE5), "--dry-run"], "this is a scenario file, not a sweep spec"),
+        (["dataset", str(CASE5), "--out", "x", "--estimate-only"], "not a dataset spec"),
+        (["record", str(DEMO)], "this is a sweep spec, not a scenario file"),
+        (["closed-loop", str(DEMO)], f"run it with `monopic sweep {DEMO}`"),
+    ],
+)
+def test_a_scenario_file_and_a_sweep_spec_given_for_each_other_are_named(
+    capsys: pytest.CaptureFixture[str], argv: list[str], expected: str
+) -> None:
+    assert main(argv) == 2
+    assert expected in one_line_error(capsys)
+
+
+def test_a_misspelt_required_key_is_named_as_unknown(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    spec = tmp_path / "spec.toml"
+    spec.write_text(f'name = "x"\n[[include]]\nfile = ["{CASE5}"]\n')
+    assert main(["sweep", str(spec), "--dry-run"]) == 2
+    assert one_line_error(capsys) == (
+        f"monopic sweep: error: {spec}: include[0].file = ['{CASE5}']: unknown key, and "
+        "include[0].files is missing: did you mean 'files'?"
+    )
+    spec.write_text(f'name = "x"\n[[include]]\nfiles = ["{CASE5}"]\nsamplng = "grid"\n')
+    assert main(["sweep", str(spec), "--dry-run"]) == 2
+    assert "include[0].samplng = 'grid': unknown key (did you mean 'sampling'? known" in (
+        one_line_error(capsys)
+    )
+    scenario = tmp_path / "s.toml"
+    scenario.write_text(CASE5.read_text().replace('kind = "case"\ncase', 'knid = "case"\ncase'))
+    assert main(["record", str(scenario)]) == 2
+    assert "path.knid = 'case': unknown key, and path.kind is missing" in one_line_error(capsys)
+
+
+def test_base_sampling_applies_its_parameters_and_refuses_draw_settings(tmp_path: Path) -> None:
+    """sampling = "base" with [include.parameters] used to drop them without a word."""
+    from monopic.errors import UserError
+    from sim.runs.sweep import expand_spec, load_spec
+
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        f'name = "x"\n[[include]]\nfiles = ["{CASE5}"]\nsampling = "base"\n'
+        '[include.parameters]\nduration = [2.0]\n"robot.speed" = [0.0, 1.0]\n'
+    )
+    runs = expand_spec(load_spec(spec))
+    assert [r.params for r in runs] == [
+        {"duration": 2.0, "robot.speed": 0.0},
+        {"duration": 2.0, "robot.speed": 1.0},
+    ]
+    assert {r.scenario.duration for r in runs} == {2.0}
+    assert [r.scenario.robot.speed for r in runs] == [0.0, 1.0]
+    # Without parameters: one run at the file's own values (its 18-run sweep dropped).
+    spec.write_text(f'name = "x"\n[[include]]\nfiles = ["{CASE5}"]\nsampling = "base"\n')
+    (run,) = expand_spec(load_spec(spec))
+    assert run.params == {} and run.scenario.duration == 4.0
+    for sampling, key in (("base", "runs = 3"), ("grid", "seed = 2")):
+        spec.write_text(
+            f'name = "x"\n[[include]]\nfiles = ["{CASE5}"]\nsampling = "{sampling}"\n{key}\n'
+        )
+        with pytest.raises(UserError) as err:
+            load_spec(spec)
+        assert str(err.value) == (
+            f"{spec}: include[0].{key}: draws at random only: "
+            f'sampling = "{sampling}" would ignore it'
+        )
+
+
+def test_every_command_makes_the_folder_its_output_goes_to(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """One rule for output paths (README): a missing folder is created, for tree and replay
+    here; video (test_cli_video_errors), sweep and report (test_sweep), closed-loop and
+    dataset (below) and record (tests/test_walkthrough.py) in their own tests."""
+    from tests.paths import DATA
+
+    logs = sorted((DATA / "authors").glob("data*.csv"))
+    tree = tmp_path / "a" / "b" / "tree.json"
+    assert main(["tree", "train", *map(str, logs[:2]), "--out", str(tree)]) == 0
+    assert tree.is_file()
+    table = tmp_path / "c" / "d" / "pred.csv"
+    assert main(["replay", str(logs[2]), "--tree", str(tree), "--csv", str(table)]) == 0
+    assert table.read_text().count("\n") > 10
+    capsys.readouterr()
+    (tmp_path / "plain").write_text("x")
+    assert main(["tree", "train", str(logs[0]), "--out", str(tmp_path / "plain" / "t.json")]) == 2
+    assert one_line_error(capsys).endswith("a file is in the way of this folder")
+    assert main(["tree", "train", str(logs[0]), "--out", str(tmp_path)]) == 2
+    assert one_line_error(capsys).endswith(f"--out {tmp_path}: is a folder; give a file name")
+
+
+TINY = """
+name = "tiny"
+kind = "collision"
+duration = 0.4
+[robot.camera]
+width = 256
+height = 144
+[path]
+kind = "case"
+case = 5
+distance = 3.0
+[sweep]
+sampling = "grid"
+[sweep.parameters]
+"robot.speed" = [0.0, 1.0, 2.0]
+"""
+
+
+def test_dry_run_shows_runs_per_family_and_a_time_it_says_how_it_computed(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import json
+
+    (tmp_path / "tiny.toml").write_text(TINY)
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        f'name = "t"\n[[include]]\nfiles = ["tiny.toml", "{CASE5}"]\nsampling = "base"\n'
+    )
+    out = tmp_path / "r.jsonl"
+    assert main(["sweep", str(spec), "--out", str(out), "--dry-run", "--workers", "2"]) == 0
+    lines = capsys.readouterr().out.splitlines()
+    assert lines[0] == f"{spec}: 2 runs in 2 families, 0 already in {out}, 2 to run"
+    assert lines[1].split() == ["family", "kind", "scale", "runs", "to", "run", "frames", "(at",
+                                "most)"]  # fmt: skip
+    assert lines[2].split() == ["cases", "case", "small", "1", "1", "60"]
+    assert lines[3].split() == ["tiny", "collision", "small", "1", "1", "6"]
+    # 6 frames at 256x144 and 60 at 768x432, each with the ablation, on 2 workers.
+    bench = (6 * (0.0456 / 9 + 0.0339 + 0.0217) + 60 * 0.1012) / 66
+    assert lines[4] == (
+        f"time: about 11 s on 2 workers: 8 s to start, then up to 66 frames x {bench:.3f} s "
+        "per frame and worker "
+        "(the simulator benchmark's 79.5/101.2 ms per 768x432 frame (bench/history.jsonl); "
+        "no run measured yet)"
+    )
+    assert not out.exists()  # a dry run writes nothing
+    # Finished runs in the results file replace the benchmark's figure by their own.
+    rows = [{"id": "x/1", "frames": 10, "timing": {"wall_s": 3.0}},
+            {"id": "x/2", "frames": 30, "timing": {"wall_s": 5.0}}]  # fmt: skip
+    out.write_text("".join(json.dumps(r) + "\n" for r in rows))
+    assert main(["sweep", str(spec), "--out", str(out), "--dry-run", "--no-ablation"]) == 0
+    time_line = capsys.readouterr().out.splitlines()[4]
+    assert time_line.startswith("time: about ") and time_line.endswith(
+        f"up to 66 frames x 0.200 s per frame and worker (measured on 2 finished runs in {out})"
+    )
+
+
+def test_a_sweep_reports_the_recordings_it_kept_and_leaves_no_empty_folders(
+    tmp_path: Path,
+) -> None:
+    from sim.commands.sweep import kept_recordings
+
+    folder = tmp_path / "r_rrd"
+    (folder / "cases").mkdir(parents=True)
+    (folder / "cpna-25" / "deeper").mkdir(parents=True)
+    (folder / "cpna-25" / "0001-ab.rrd").write_bytes(b"RRF2")
+    assert kept_recordings(folder, "failed") == (
+        f"recordings (missed collisions and false alarms): 1 in {folder}"
+    )
+    assert sorted(p.relative_to(folder).as_posix() for p in folder.rglob("*")) == [
+        "cpna-25",
+        "cpna-25/0001-ab.rrd",
+    ]
+    (folder / "cpna-25" / "0001-ab.rrd").unlink()
+    assert kept_recordings(folder, "all") == "recordings (every run): none kept"
+    assert not folder.exists()
+    assert kept_recordings(folder, "failed").endswith("none kept")
+
+
+def test_report_of_a_file_that_is_not_a_results_file_says_so(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    walk = tmp_path / "walk.csv"
+    walk.write_text("time,x\n1,2\n")
+    assert main(["report", str(walk)]) == 2
+    err = one_line_error(capsys)
+    assert err == (
+        f"monopic report: error: {walk}: not a sweep's results file (its first line, "
+        "'time,x', is not a JSON result line): give the .jsonl that `monopic sweep` writes"
+    )
+    assert "--out" not in err
+    assert not (tmp_path / "walk_report").exists()
+    empty = tmp_path / "empty.jsonl"
+    empty.write_text("")
+    assert main(["report", str(empty)]) == 2
+    assert one_line_error(capsys).endswith(f"{empty}: no finished runs in it yet")
+
+
+@pytest.mark.parametrize(
+    ("option", "key", "value", "reason"),
+    [
+        ("--distance", "path.distance", -3.0, "must be >= 0 m"),
+        (
+            "--lateral-offset",
+            "path.lateral_offset",
+            40.0,
+            "the pedestrian's path leaves the street",
+        ),
+        ("--robot-speed", "robot.speed", 25.0, "must be <= 20 m/s"),
+        ("--duration", "duration", 0.0, "must be > 0 s"),
+    ],
+)
+def test_record_checks_a_case_as_a_scenario_file_checks_it(
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    option: str,
+    key: str,
+    value: float,
+    reason: str,
+) -> None:
+    """The same value is refused on the command line and in a file, for the same reason."""
+    from sim.scenario.files import build, with_values
+    from sim.scenario.toml_table import FieldError
+
+    # Case 5 as a file, with the command's robot (RobotSpec's limits: 20 m/s).
+    text = CASE5.read_text().split("[sweep]")[0].replace("[robot]", "[robot]\nmax_speed = 20.0")
+    with pytest.raises(FieldError) as in_file:
+        build(CASE5, with_values(tomllib.loads(text), {key: value}))
+    assert reason in in_file.value.reason
+    assert main(["record", "5", option, str(value), "--rrd", str(tmp_path / "x.rrd")]) == 2
+    err = one_line_error(capsys)
+    assert f"{option} {value:g}" in err and reason in err
+    assert not (tmp_path / "x.rrd").exists()
+
+
+def test_ray_log_lines_go_above_the_progress_bar_not_into_it(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Ray logs its start and code upload through the 'ray' logger while the sweep's bar is
+    drawn; inside the sweep they are written by tqdm, which clears the bar line first."""
+    import logging
+
+    from tqdm import tqdm
+
+    from sim.commands.sweep import logs_above_the_bar
+
+    pytest.importorskip("ray")
+    ray_logger = logging.getLogger("ray")
+    before = list(ray_logger.handlers)
+    with logs_above_the_bar("ray"), tqdm(total=2, desc="sweep", ncols=60) as bar:
+        bar.update(1)
+        logging.getLogger("ray._private.worker").warning("Started a local Ray instance.")
+        bar.update(1)
+    assert ray_logger.handlers == before  # restored after the sweep
+    # Joining a cluster: ray is imported under the executor's connect timeouts, which do
+    # not outlive the import (a local instance's processes must not inherit them).
+    from sim.runs.executors import RAY_CONNECT_ENV
+
+    with logs_above_the_bar("ray", "127.0.0.1:1"):
+        assert not set(RAY_CONNECT_ENV) & set(os.environ)
+    err = capsys.readouterr().err
+    (logged,) = [seg for seg in err.split("\r") if "Started a local" in seg]
+    # tqdm.write: the bar's line cleared, the message on a line of its own, the bar redrawn
+    # after it; without the redirect the message is glued to the bar's text ("| 1/2 [...]").
+    assert logged.endswith("Started a local Ray instance.\n") and "|" not in logged, err
+
+
+@pytest.mark.slow
+def test_closed_loop_and_dataset_make_their_output_folders(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """The output rule for the two commands the walkthrough runs without --out."""
+    scenario = tmp_path / "tiny.toml"
+    scenario.write_text(TINY.split("[sweep]")[0])
+    table = tmp_path / "a" / "b" / "table.md"
+    rrd_dir = tmp_path / "c" / "rrd"
+    argv = ["closed-loop", str(scenario), "--speeds", "1", "--policies", "none,truth"]
+    assert main([*argv, "--out", str(table), "--rrd-dir", str(rrd_dir)]) == 0
+    assert table.read_text().startswith("# Closed loop") and rrd_dir.is_dir()
+    spec = tmp_path / "spec.toml"
+    spec.write_text('name = "t"\n[[include]]\nfiles = ["tiny.toml"]\nsampling = "base"\n')
+    out = tmp_path / "d" / "e" / "dataset"
+    capsys.readouterr()
+    assert main(["dataset", str(spec), "--out", str(out)]) == 0
+    assert (out / "README.md").is_file() and (out / "runs").is_dir()
+    printed = capsys.readouterr().out
+    assert "time: about 3 s on 1 worker: 3 s to start, then up to 6 frames x " in printed
