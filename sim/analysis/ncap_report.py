@@ -186,9 +186,9 @@ def plot_matrices(
         ax.set_title(f"{test.load_case} ({test.target_speed_kmh:g} km/h target)", fontsize=10)
         ax.set_xlabel("impact location")
     fig.suptitle(
-        f"{policy}: prediction colour (worst run); cell text worst / mean impact km/h "
+        f"{policy}: prediction colour (worst run)\ncells: worst / mean impact km/h "
         "(FCW: TTC s); grey: not run",
-        fontsize=10,
+        fontsize=9,
     )
     fig.tight_layout()
     fig.savefig(out, dpi=110)
@@ -218,7 +218,8 @@ def points_table(points: Sequence[PointSummary], policy: str) -> str:
     return "\n".join(lines)
 
 
-def score_table(scores: dict[str, CalculatorScore]) -> str:
+def score_table(scores: dict[str, CalculatorScore], claimed: set[str]) -> str:
+    """The calculator's points per load case (tests not run: not claimed, "-")."""
     lines = [
         "| policy | CPNA | CPFA | CPNCO | CPLA | pedestrian total | Frontal Collisions, Ped & Cyc "
         "(test score) |",
@@ -228,7 +229,10 @@ def score_table(scores: dict[str, CalculatorScore]) -> str:
         cells_ = []
         for name in ("CPNA", "CPFA", "CPNCO", "CPLA"):
             lc = s.load_cases.get(name)
-            cells_.append("-" if lc is None else f"{lc.total:.3g} / {lc.max_total:g}")
+            if lc is None or name not in claimed:
+                cells_.append("not run")
+            else:
+                cells_.append(f"{lc.total:.3g} / {lc.max_total:g}")
         lines.append(
             f"| {policy} | {' | '.join(cells_)} | {s.pedestrian_score:.3g} / "
             f"{s.pedestrian_max:g} | {s.ped_cyc_score:.3g} / {s.ped_cyc_max:g} |"
@@ -274,9 +278,10 @@ def render(
         "# Euro NCAP 2026 pedestrian tests at car scale",
         "",
         f"Command: `{command}`. Grid: {'the --quick grid' if quick else 'the full grid'} of "
-        f"{', '.join(tests)}{'' if speeds is None else f' at {speeds} km/h'}, {len(points)} "
-        f"grid points x policies, {seeds} jittered runs each plus {car.verification_seeds} "
-        f"verification run; {grid_runs} grid, {verify_runs} verification and {nm_runs} "
+        f"{', '.join(tests)}{'' if speeds is None else f' at {speeds} km/h'}: "
+        f"{len(points) // max(1, len(scores))} grid points per policy, {seeds} jittered runs "
+        f"each plus {car.verification_seeds} verification run; {grid_runs} grid, "
+        f"{verify_runs} verification and {nm_runs} "
         f"near-miss runs. Machine: {machine}. Wall time of this command {wall_s / 60:.1f} min "
         f"({ran_now} runs now, the rest resumed); run time summed over all runs "
         f"{run_wall / 60:.1f} min.",
@@ -290,7 +295,7 @@ def render(
         "Per load case: standard + extended + robustness points of the calculator's Scenario "
         "Scores over their maximum (day and night together: the night half is not run).",
         "",
-        score_table(scores),
+        score_table(scores, {protocol.tests[t].load_case.split(" ")[0] for t in tests}),
         "",
         f"Left unscored: {left_unscored}.",
         "",

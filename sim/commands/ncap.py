@@ -41,8 +41,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument("--tests", default="cpna,cpfa,cpnco,cpla", help="default: all four")
     p.add_argument("--quick", action="store_true", help="the thin grid (CI and the demo)")
     p.add_argument("--speeds", help="only these car speeds, km/h, e.g. 20,40")
-    p.add_argument("--policies", help="default: the car file's (primary first)")
-    p.add_argument("--seeds", type=int, help="jittered runs per grid point (default: car file)")
+    p.add_argument("--policies", help="default: the car file's (--quick: its primary)")
+    p.add_argument(
+        "--seeds", type=int, help="jittered runs per grid point (default: the car file's)"
+    )
     p.add_argument("--no-near-misses", action="store_true", help="skip the near misses")
     p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
     p.add_argument("--executor", choices=("local", "ray"), default="local")
@@ -97,7 +99,8 @@ def run(args: argparse.Namespace) -> int:
                     f"--speeds {v:g}: not a test speed of the protocol's grid ({spans} km/h "
                     "in 10 km/h steps)"
                 )
-    policies = car.policies if args.policies is None else tuple(
+    default = (car.primary,) if args.quick else car.policies  # quick: the primary only
+    policies = default if args.policies is None else tuple(
         p.strip() for p in args.policies.split(",") if p.strip()
     )  # fmt: skip
     from monopic.predict.base import Mode
@@ -165,7 +168,7 @@ def run(args: argparse.Namespace) -> int:
         tests=tests,
         quick=args.quick,
         speeds=speeds,
-        seeds=args.seeds or car.seeds,
+        seeds=args.seeds or (car.quick_seeds if args.quick else car.seeds),
         rows=rows,
         points=points,
         scores=scores,
@@ -179,7 +182,7 @@ def run(args: argparse.Namespace) -> int:
         out=args.out,
     )
     write_text_atomically(args.out / "report.md", text)
-    print(rep.score_table(scores))
+    print(rep.score_table(scores, claimed))
     print(f"report: {args.out / 'report.md'}")
     return 0
 

@@ -77,7 +77,7 @@ def expand(
 ) -> list[NcapRun]:
     """Every run of the grid, in a stable order (policy, point, role, draw)."""
     aeb = aeb_params(car)
-    n_grid = car.seeds if seeds is None else seeds
+    n_grid = (car.quick_seeds if quick else car.seeds) if seeds is None else seeds
     points = grid(protocol, tests, quick, speeds)
     runs = []
     for policy in policies:

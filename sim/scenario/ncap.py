@@ -139,6 +139,7 @@ class CarSpec:
     name: str
     max_speed: float
     seeds: int
+    quick_seeds: int
     verification_seeds: int
     primary: str
     policies: tuple[str, ...]
@@ -320,6 +321,7 @@ def load_car(path: Path | str = CAR_FILE) -> CarSpec:
         name=top.slug("name"),
         max_speed=top.number("max_speed", positive=True, high=40.0, unit="m/s"),
         seeds=top.integer("seeds", low=1, high=100),
+        quick_seeds=top.integer("quick_seeds", low=1, high=100),
         verification_seeds=top.integer("verification_seeds", 1, low=0, high=10),
         primary=primary,
         policies=policies,
