@@ -19,7 +19,10 @@ speed = {robot_speed}
 speed = 1.4
 """
 CASE = '[path]\nkind = "case"\ncase = 5\ndistance = 6.0\n'
-CROSSING = '[path]\nkind = "crossing"\nside = "near"\nimpact_point = 0.5\nimpact_time = 3.0\n'
+CROSSING = (
+    '[path]\nkind = "crossing"\nside = "near"\nimpact_point = 0.5\nimpact_time = 3.0\n'
+    "approach = 3.0\n"  # m: the rail target accelerates over 1 m, so 3 m fit in 3 s
+)
 ALONG = '[path]\nkind = "longitudinal"\nimpact_point = 0.5\nimpact_time = 2.0\n'
 EXPLICIT = '[path]\nkind = "explicit"\nx = 5.0\ny = -3.0\nheading_deg = 90.0\n'
 PARKED = '[scene.parked_cars]\nplacement = "fixed"\n'
