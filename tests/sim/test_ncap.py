@@ -192,7 +192,8 @@ def test_a_missing_calculator_is_one_line(tmp_path, capsys, monkeypatch):
 def test_ncap_command_runs_scores_and_resumes(tmp_path, capsys):
     out = tmp_path / "ncap"
     argv = ["ncap", "--tests", "cpna", "--quick", "--speeds", "20", "--seeds", "1",
-            "--policies", "rules/ground", "--no-near-misses", "--workers", "2", "--out", str(out)]  # fmt: skip
+            "--policies", "rules/ground", "--no-near-misses", "--workers", "2",
+            "--out", str(out)]  # fmt: skip
     assert main(argv) == 0
     rows = [json.loads(line) for line in (out / "results.jsonl").read_text().splitlines()]
     assert len(rows) == 2 and {r["role"] for r in rows} == {"grid", "verify"}
