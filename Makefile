@@ -5,14 +5,14 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed-stamp
 export MUJOCO_GL ?= egl
 
-.PHONY: install demo test lint format clean-venv realism
+.PHONY: install demo test lint format clean-venv realism ncap
 
 install: $(STAMP)
 
 # (Re)install when the project's dependency pins change.
 $(STAMP): pyproject.toml requirements.lock
 	@test -x $(BIN)/python || $(PY) -m venv $(VENV)
-	$(BIN)/python -m pip install -q -c requirements.lock -e '.[dev,ray]'
+	$(BIN)/python -m pip install -q -c requirements.lock -e '.[dev,ray,ncap]'
 	@touch $(STAMP)
 
 # The pipeline on the shipped clip, then the default sweep of every case and family
@@ -23,6 +23,13 @@ demo: $(STAMP)
 		--out recordings/demo.mp4 --csv recordings/demo.csv --rrd recordings/demo.rrd
 	$(BIN)/monopic sweep scenarios/sweeps/demo.toml --out recordings/demo.jsonl --restart
 	$(BIN)/monopic report recordings/demo.jsonl --out recordings/demo_report
+	$(BIN)/monopic ncap --quick --restart --out recordings/ncap-quick
+
+# The Euro NCAP 2026 pedestrian grid, thin (--quick, a few minutes on 2 cores), scored by
+# the official rating calculator (extra [ncap]): recordings/ncap-quick/report.md.
+# The full grid: `.venv/bin/monopic ncap --workers 2 --out recordings/ncap-full` (resumable).
+ncap: $(STAMP)
+	$(BIN)/monopic ncap --quick --out recordings/ncap-quick
 
 test: $(STAMP) lint
 	$(BIN)/python -m pytest -q

@@ -389,11 +389,14 @@ def _connect(ray: Any, address: str | None, upload_code: bool) -> None:
                 signal.signal(signal.SIGTERM, sigterm)
 
 
-def ray_executor(address: str | None, upload_code: bool = True) -> Callable[..., None]:
+def ray_executor(
+    address: str | None, upload_code: bool = True, run: Callable[..., dict[str, Any]] = work
+) -> Callable[..., None]:
     """Runs as Ray tasks (one CPU each) on the cluster at `address` (None: RAY_ADDRESS or local).
 
     If this process already called ray.init (e.g. a test's local instance), that
     connection is used as it is. Joining takes at most a few RAY_CONNECT_TIMEOUT_S.
+    `run` is what a task calls per spec (default: a sweep run; `monopic ncap` passes its own).
     """
 
     def execute(specs: Sequence[RunSpec], on_result: Callable[[dict[str, Any]], None]) -> None:
@@ -411,7 +414,7 @@ def ray_executor(address: str | None, upload_code: bool = True) -> Callable[...,
                 ) from None
             if not ray.is_initialized():
                 _connect(ray, address, upload_code)
-        remote = ray.remote(num_cpus=1)(work)
+        remote = ray.remote(num_cpus=1)(run)
         pending = [remote.remote(spec) for spec in specs]
         try:
             while pending:

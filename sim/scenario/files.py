@@ -50,6 +50,7 @@ from sim.scenario.path import pedestrian_path
 from sim.scenario.spec import (
     BEHAVIOURS,
     Behaviour,
+    BodyPitch,
     CameraSpec,
     Leg,
     Occluder,
@@ -423,9 +424,21 @@ def _robot(t: TomlTable, preset: RobotSpec) -> RobotSpec:
             "max_deceleration", preset.max_deceleration, positive=True, high=15.0, unit="m/s^2"
         ),
         max_speed=max_speed,
+        pitch=_pitch(t.table("pitch"), preset.pitch),
     )
     t.done()
     return robot
+
+
+def _pitch(t: TomlTable, preset: BodyPitch) -> BodyPitch:
+    """[robot.pitch]: the body's nose dip when braking (sim.scenario.spec.BodyPitch)."""
+    pitch = BodyPitch(
+        gain=t.number("gain", preset.gain, low=0.0, high=2.0, unit="deg per m/s^2"),
+        frequency=t.number("frequency", preset.frequency, low=0.2, high=10.0, unit="Hz"),
+        damping=t.number("damping", preset.damping, low=0.05, high=5.0),
+    )
+    t.done()
+    return pitch
 
 
 def _camera(t: TomlTable, preset: CameraSpec) -> CameraSpec:

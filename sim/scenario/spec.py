@@ -134,6 +134,27 @@ class CameraSpec:
 
 
 @dataclass(frozen=True)
+class BodyPitch:
+    """How the robot's body (and the camera on it) pitches when it brakes: the nose dip.
+
+    A damped second-order response of the pitch angle to the longitudinal acceleration:
+    in steady braking at `a` m/s^2 the body settles at `gain * (-a)` degrees nose down,
+    with the body's pitch mode at `frequency` Hz and relative damping `damping`. The
+    rendered camera and the ground truth follow the real pitch; the pipeline keeps the
+    nominal CameraModel it was given (as a real car's calibration does). Gain 0 (the
+    default): a rigid body that never pitches.
+    """
+
+    gain: float = 0.0  # degrees nose down per m/s^2 of deceleration
+    frequency: float = 1.5  # Hz, the body's pitch mode
+    damping: float = 0.7  # relative damping of that mode
+
+    def __post_init__(self) -> None:
+        if not (self.gain >= 0 and self.frequency > 0 and self.damping > 0):
+            raise ValueError("body pitch needs gain >= 0, frequency > 0 and damping > 0")
+
+
+@dataclass(frozen=True)
 class RobotSpec:
     """The camera-carrying robot: a highway-env vehicle of this size and speed."""
 
@@ -145,6 +166,7 @@ class RobotSpec:
     max_acceleration: float = 3.0
     max_deceleration: float = 8.0  # braking, as a positive number
     max_speed: float = 20.0
+    pitch: BodyPitch = field(default_factory=BodyPitch)  # nose dip when braking
 
     def geometry(self) -> RobotGeometry:
         """The pipeline's own footprint: a robot knows its size (reference point = centre)."""

@@ -12,14 +12,21 @@ the process that steps the world; EGL contexts do not survive fork, so build Wor
 inside spawned workers from the (plain-data) Scenario. With `render=False` no renderer is
 ever made and `WorldStep.frame` is None; everything else, the ground truth included
 (occlusion is a ray test, not a mask), is the same, which makes ground-truth-only runs fast.
+
+Nose dip: with a RobotSpec.pitch gain the body pitches with the applied acceleration
+(a damped second-order response, integrated in each step). The camera is rendered at
+the real pitch (turned about its own centre) and the truth's image positions use it
+(`true_camera`); the pipeline's EgoState keeps the nominal CameraModel, as a car's
+camera calibration does not know the momentary dip.
 """
 
 from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
+import mujoco
 import numpy as np
 from highway_env.road.road import Road
 
@@ -29,6 +36,7 @@ from monopic.frame import EgoState, Frame
 from sim.geometry.frames import Pose2D, wrap_angle
 from sim.scenario.path import PathState
 from sim.scenario.spec import Scenario
+from sim.world.body import PedestrianTruth, image_box
 from sim.world.ground_truth import (
     CASE_WINDOW,
     TORSO_LANDMARKS,
@@ -49,6 +57,7 @@ from sim.world.scene import Scene, SceneConfig
 
 ROBOT_START = Pose2D(0.0, 0.0, 0.0)  # the world origin, heading east along the road
 TTC_LOOKAHEAD = 10.0  # s: how far ahead the time to collision is searched
+PITCH_SUBSTEP = 0.005  # s, integration step of the body's pitch response
 
 
 @dataclass(frozen=True)
@@ -93,6 +102,9 @@ class World(Closing):
         self.index = 0
         self.seed = scenario.seed
         self._yaw_rate = 0.0
+        self.pitch = 0.0  # rad, the body's momentary nose-down pitch (RobotSpec.pitch)
+        self._pitch_rate = 0.0
+        self._robot_mocap = int(self.scene.model.body("robot").mocapid[0])
         self.last: WorldStep | None = None
 
     # -- stepping ---------------------------------------------------------------------
@@ -114,6 +126,7 @@ class World(Closing):
         self.pedestrian.reset(gait_phase=float(rng.uniform()))
         self.road.objects.append(self.pedestrian)
         self.time, self.index, self._yaw_rate = 0.0, 0, 0.0
+        self.pitch, self._pitch_rate = 0.0, 0.0
         return self._observe()
 
     def step(self, dt: float | None = None, action: float = 0.0) -> WorldStep:
@@ -134,6 +147,7 @@ class World(Closing):
         self.road.act()
         self.road.step(dt)
         self._yaw_rate = wrap_angle(self.robot.world_pose.yaw - yaw_before) / dt
+        self._advance_pitch(dt, float(self.robot.applied_acceleration))
         self.time = self.pedestrian.time
         self.index += 1
         return self._observe()
@@ -145,6 +159,63 @@ class World(Closing):
         for _ in range(self.scenario.frames - 1):
             step = self.step(action=policy(step) if policy else 0.0)
             yield step
+
+    # -- the body's pitch ---------------------------------------------------------------
+
+    @property
+    def true_camera(self) -> CameraModel:
+        """The camera as it really points now: the nominal one turned by the body's pitch."""
+        if self.pitch == 0.0:
+            return self.camera
+        return replace(self.camera, pitch=self.camera.pitch + self.pitch)
+
+    def _advance_pitch(self, dt: float, acceleration: float) -> None:
+        """Integrate the pitch response to `acceleration` (m/s^2) over one step."""
+        spec = self.scenario.robot.pitch
+        if spec.gain == 0.0:
+            return
+        target = math.radians(spec.gain * -acceleration)  # braking: nose down (+)
+        omega = 2 * math.pi * spec.frequency
+        n = max(1, math.ceil(dt / PITCH_SUBSTEP))
+        h = dt / n
+        for _ in range(n):  # semi-implicit Euler: stable for these stiffnesses
+            accel = omega**2 * (target - self.pitch) - 2 * spec.damping * omega * self._pitch_rate
+            self._pitch_rate += h * accel
+            self.pitch += h * self._pitch_rate
+
+    def _pose_pitched_camera(self, x: float, y: float, yaw: float) -> None:
+        """Turn the MuJoCo robot body by the pitch about the camera's centre."""
+        scene = self.scene
+        q_yaw = np.array([math.cos(yaw / 2), 0.0, 0.0, math.sin(yaw / 2)])
+        q_pitch = np.array([math.cos(self.pitch / 2), 0.0, math.sin(self.pitch / 2), 0.0])
+        quat = np.empty(4)
+        mujoco.mju_mulQuat(quat, q_yaw, q_pitch)
+        c = self.camera.position
+        s, k = math.sin(self.pitch), math.cos(self.pitch)
+        pitched = np.array([k * c[0] + s * c[2], c[1], -s * c[0] + k * c[2]])  # R_y c
+        d = c - pitched  # keep the camera centre where the unpitched body puts it
+        cy, sy = math.cos(yaw), math.sin(yaw)
+        scene.data.mocap_pos[self._robot_mocap] = (
+            x + cy * d[0] - sy * d[1],
+            y + sy * d[0] + cy * d[1],
+            d[2],
+        )
+        scene.data.mocap_quat[self._robot_mocap] = quat
+        mujoco.mj_kinematics(scene.model, scene.data)
+        mujoco.mj_camlight(scene.model, scene.data)
+
+    def _seen_by(self, body: PedestrianTruth, camera: CameraModel) -> PedestrianTruth:
+        """The body's image positions through `camera` (the real, pitched one)."""
+        scene = self.scene
+        surface = scene.mannequin.surface_points(scene.model, scene.data)
+        box, in_frame = image_box(camera, scene.world_to_robot(surface))
+        return replace(
+            body,
+            landmarks_px=camera.project(body.landmarks_robot),
+            foot_px=camera.project(body.foot_robot),
+            box=box,
+            in_frame=in_frame,
+        )
 
     # -- rendering --------------------------------------------------------------------
 
@@ -186,6 +257,8 @@ class World(Closing):
         robot = self.robot_state()
         ped = self.pedestrian.state
         self.scene.set_camera_pose(robot.pose.x, robot.pose.y, robot.pose.yaw)
+        if self.pitch != 0.0:
+            self._pose_pitched_camera(robot.pose.x, robot.pose.y, robot.pose.yaw)
         self.scene.set_pedestrian(
             ped.position[0],
             ped.position[1],
@@ -204,7 +277,7 @@ class World(Closing):
 
     def _ground_truth(self, robot: RobotState, ped: PathState) -> GroundTruth:
         assert self.robot is not None and self.pedestrian is not None
-        scenario, scene, camera = self.scenario, self.scene, self.camera
+        scenario, scene, camera = self.scenario, self.scene, self.true_camera
         pose = robot.pose
         c, s = math.cos(pose.yaw), math.sin(pose.yaw)
 
@@ -227,6 +300,8 @@ class World(Closing):
         )
 
         body = scene.truth()
+        if camera is not self.camera:
+            body = self._seen_by(body, camera)
         centre_px = camera.project(body.landmarks_robot[list(TORSO_LANDMARKS)].mean(axis=0))
         camera_world = scene.data.cam_xpos[scene.camera_id].copy()
         hidden = occluded_landmarks(

@@ -1,0 +1,363 @@
+"""The Euro NCAP grid's results: per grid point worst and mean, colour matrices, report.md.
+
+A grid point's prediction is the calculator's colour band of its worst grid run (the
+highest relative impact speed, or the shortest FCW TTC): a manufacturer claims what its
+virtual tests show at worst. Its verification value is the mean of its verification
+runs (one by default), run apart from the prediction's. The calculator (sim.analysis.
+ncap_score) turns predictions and verification values into points; this module writes
+what it said beside the project's own figures: impact speed, speed reduction and warning
+TTC per grid point (worst and mean), recall and lead time, and the near misses' braking.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import defaultdict
+from collections.abc import Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from sim.analysis.ncap_score import CalculatorScore, Cell, band_colour, percent
+from sim.runs.ncap_grid import GRID, NEAR_MISS, VERIFY
+from sim.scenario.ncap import Protocol
+
+COLOURS = {  # the calculator's own RGB (common.PREDICTION_COLOR_MAP)
+    "Green": (0 / 255, 153 / 255, 51 / 255),
+    "Yellow": (255 / 255, 221 / 255, 51 / 255),
+    "Orange": (255 / 255, 153 / 255, 51 / 255),
+    "Brown": (150 / 255, 75 / 255, 0 / 255),
+    "Red": (255 / 255, 51 / 255, 51 / 255),
+}
+NOT_RUN = (0.85, 0.85, 0.85)
+
+
+def value(row: dict[str, Any]) -> float:
+    """What the calculator judges a run by: relative impact speed (km/h) or FCW TTC (s)."""
+    o = row["outcome"]
+    if row["function"] == "FCW":
+        return 0.0 if o["warning_ttc"] is None else float(o["warning_ttc"])
+    rel = o["relative_impact_speed"]
+    return 0.0 if not o["contact"] or rel is None else float(rel) * 3.6
+
+
+@dataclass(frozen=True)
+class PointSummary:
+    """One grid point under one policy: its grid runs and its verification runs."""
+
+    policy: str
+    test: str
+    load_case: str
+    function: str
+    speed_kmh: float
+    impact: float
+    runs: int
+    contacts: int
+    worst: float  # the judged value at worst (max impact speed / min TTC)
+    mean: float
+    impact_kmh_worst: float  # relative impact speed, km/h (0: avoided)
+    impact_kmh_mean: float
+    reduction_kmh_mean: float
+    warning_ttc_worst: float | None  # s (None: a run without warning)
+    warning_ttc_mean: float | None
+    verification: float | None
+    colour: str  # the prediction: the calculator's band of `worst`
+
+
+def summarise(rows: Sequence[dict[str, Any]]) -> list[PointSummary]:
+    """Per (policy, grid point), in the rows' order."""
+    groups: dict[tuple, list[dict[str, Any]]] = defaultdict(list)
+    for row in rows:
+        if row["role"] in (GRID, VERIFY):
+            key = (row["policy"], row["test"], row["load_case"], row["function"],
+                   row["speed_kmh"], row["impact"])  # fmt: skip
+            groups[key].append(row)
+    out = []
+    for (policy, test, case, function, speed, impact), members in groups.items():
+        grid = [r for r in members if r["role"] == GRID]
+        verify = [r for r in members if r["role"] == VERIFY]
+        if not grid:
+            continue
+        values = [value(r) for r in grid]
+        impacts = [value(r) if function == "AEB" else _impact_kmh(r) for r in grid]
+        ttcs = [r["outcome"]["warning_ttc"] for r in grid]
+        worst = min(values) if function == "FCW" else max(values)
+        out.append(
+            PointSummary(
+                policy=policy,
+                test=test,
+                load_case=case,
+                function=function,
+                speed_kmh=speed,
+                impact=impact,
+                runs=len(grid),
+                contacts=sum(r["outcome"]["contact"] for r in grid),
+                worst=worst,
+                mean=float(np.mean(values)),
+                impact_kmh_worst=max(impacts),
+                impact_kmh_mean=float(np.mean(impacts)),
+                reduction_kmh_mean=float(
+                    np.mean([r["outcome"]["speed_reduction"] * 3.6 for r in grid])
+                ),
+                warning_ttc_worst=None if None in ttcs else float(min(ttcs)),
+                warning_ttc_mean=float(np.mean([t for t in ttcs if t is not None]))
+                if any(t is not None for t in ttcs)
+                else None,
+                verification=float(np.mean([value(r) for r in verify])) if verify else None,
+                colour=band_colour(case, function, speed, worst),
+            )
+        )
+    return out
+
+
+def _impact_kmh(row: dict[str, Any]) -> float:
+    o = row["outcome"]
+    rel = o["relative_impact_speed"]
+    return 0.0 if not o["contact"] or rel is None else float(rel) * 3.6
+
+
+def cells(points: Sequence[PointSummary], policy: str) -> list[Cell]:
+    return [
+        Cell(p.load_case, p.function, p.speed_kmh, p.impact, p.colour, p.verification)
+        for p in points
+        if p.policy == policy
+    ]
+
+
+@dataclass(frozen=True)
+class NearMissSummary:
+    policy: str
+    runs: int
+    braked: int
+    warned: int
+    contacts: int
+
+
+def near_misses(rows: Sequence[dict[str, Any]]) -> list[NearMissSummary]:
+    by: dict[str, list[dict[str, Any]]] = defaultdict(list)
+    for row in rows:
+        if row["role"] == NEAR_MISS:
+            by[row["policy"]].append(row)
+    return [
+        NearMissSummary(
+            policy,
+            len(rs),
+            sum(r["outcome"]["brake_time"] is not None for r in rs),
+            sum(r["outcome"]["warned_frames"] > 0 for r in rs),
+            sum(r["outcome"]["contact"] for r in rs),
+        )
+        for policy, rs in by.items()
+    ]
+
+
+def plot_matrices(
+    protocol: Protocol, points: Sequence[PointSummary], policy: str, tests: list[str], out: Path
+) -> None:
+    """One picture per policy: each load case's matrix, cells coloured by the prediction."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    mine = {(p.test, p.function, p.speed_kmh, p.impact): p for p in points if p.policy == policy}
+    fig, axes = plt.subplots(1, len(tests), figsize=(4.2 * len(tests), 4.8), squeeze=False)
+    for ax, key in zip(axes[0], tests, strict=True):
+        test = protocol.tests[key]
+        rows = [(row.function, v) for row in test.rows for v in row.speeds_kmh]
+        cols = list(test.impact_locations)
+        for i, (function, v) in enumerate(rows):
+            for j, impact in enumerate(cols):
+                p = mine.get((key, function, v, impact))
+                colour = COLOURS[p.colour] if p is not None else NOT_RUN
+                ax.add_patch(plt.Rectangle((j, i), 1, 1, facecolor=colour, edgecolor="white"))
+                if p is not None:
+                    text = (f"{p.worst:.1f}s\n{p.mean:.1f}" if function == "FCW"
+                            else f"{p.worst:.0f}\n{p.mean:.0f}")  # fmt: skip
+                    ax.text(j + 0.5, i + 0.5, text, ha="center", va="center", fontsize=8)
+        ax.set_xlim(0, len(cols))
+        ax.set_ylim(len(rows), 0)
+        ax.set_xticks([j + 0.5 for j in range(len(cols))], [percent(c) for c in cols])
+        ax.set_yticks(
+            [i + 0.5 for i in range(len(rows))],
+            [f"{v:g} km/h{' FCW' if f == 'FCW' else ''}" for f, v in rows],
+        )
+        ax.set_title(f"{test.load_case} ({test.target_speed_kmh:g} km/h target)", fontsize=10)
+        ax.set_xlabel("impact location")
+    fig.suptitle(
+        f"{policy}: prediction colour (worst run)\ncells: worst / mean impact km/h "
+        "(FCW: TTC s); grey: not run",
+        fontsize=9,
+    )
+    fig.tight_layout()
+    fig.savefig(out, dpi=110)
+    plt.close(fig)
+
+
+def _f(x: float | None, fmt: str = ".1f") -> str:
+    return "-" if x is None or (isinstance(x, float) and math.isnan(x)) else format(x, fmt)
+
+
+def points_table(points: Sequence[PointSummary], policy: str) -> str:
+    lines = [
+        "| load case | function | speed | impact | runs | contacts | impact km/h worst / mean "
+        "| speed reduction km/h mean | warning TTC s worst / mean | verification | prediction |",
+        "|" + " --- |" * 11,
+    ]
+    for p in points:
+        if p.policy != policy:
+            continue
+        verification = _f(p.verification, ".2f" if p.function == "FCW" else ".1f")
+        lines.append(
+            f"| {p.load_case} | {p.function} | {p.speed_kmh:g} km/h | {percent(p.impact)} "
+            f"| {p.runs} | {p.contacts} | {_f(p.impact_kmh_worst)} / {_f(p.impact_kmh_mean)} "
+            f"| {_f(p.reduction_kmh_mean)} | {_f(p.warning_ttc_worst, '.2f')} / "
+            f"{_f(p.warning_ttc_mean, '.2f')} | {verification} | {p.colour} |"
+        )
+    return "\n".join(lines)
+
+
+def score_table(scores: dict[str, CalculatorScore], claimed: set[str]) -> str:
+    """The calculator's points per load case (tests not run: not claimed, "-")."""
+    lines = [
+        "| policy | CPNA | CPFA | CPNCO | CPLA | pedestrian total | Frontal Collisions, Ped & Cyc "
+        "(test score) |",
+        "|" + " --- |" * 7,
+    ]
+    for policy, s in scores.items():
+        cells_ = []
+        for name in ("CPNA", "CPFA", "CPNCO", "CPLA"):
+            lc = s.load_cases.get(name)
+            if lc is None or name not in claimed:
+                cells_.append("not run")
+            else:
+                cells_.append(f"{lc.total:.3g} / {lc.max_total:g}")
+        lines.append(
+            f"| {policy} | {' | '.join(cells_)} | {s.pedestrian_score:.3g} / "
+            f"{s.pedestrian_max:g} | {s.ped_cyc_score:.3g} / {s.ped_cyc_max:g} |"
+        )
+    return "\n".join(lines)
+
+
+def recall_lead(rows: Sequence[dict[str, Any]], policy: str) -> tuple[int, int, float | None]:
+    """(warned, collision runs, median lead s) over the grid runs of a policy."""
+    grid = [r for r in rows if r["policy"] == policy and r["role"] == GRID]
+    leads = [r["outcome"]["warning_ttc"] for r in grid if r["outcome"]["warning_ttc"] is not None]
+    return len(leads), len(grid), float(np.median(leads)) if leads else None
+
+
+def render(
+    *,
+    protocol: Protocol,
+    car: Any,
+    tests: list[str],
+    quick: bool,
+    speeds: list[float] | None,
+    seeds: int,
+    rows: Sequence[dict[str, Any]],
+    points: Sequence[PointSummary],
+    scores: dict[str, CalculatorScore],
+    pictures: list[tuple[str, str]],
+    command: str,
+    machine: str,
+    wall_s: float,
+    ran_now: int,
+    version: str,
+    left_unscored: str,
+    out: Path,
+) -> str:
+    """DIR/report.md: the calculator's points first, then how they came about."""
+    grid_runs = sum(r["role"] == GRID for r in rows)
+    verify_runs = sum(r["role"] == VERIFY for r in rows)
+    nm_runs = sum(r["role"] == NEAR_MISS for r in rows)
+    run_wall = sum(r.get("wall_s", 0.0) for r in rows)
+    t = protocol.timing
+    tol = protocol.tolerances
+    lines = [
+        "# Euro NCAP 2026 pedestrian tests at car scale",
+        "",
+        f"Command: `{command}`. Grid: {'the --quick grid' if quick else 'the full grid'} of "
+        f"{', '.join(tests)}{'' if speeds is None else f' at {speeds} km/h'}: "
+        f"{len(points) // max(1, len(scores))} grid points per policy, {seeds} jittered runs "
+        f"each plus {car.verification_seeds} verification run; {grid_runs} grid, "
+        f"{verify_runs} verification and {nm_runs} "
+        f"near-miss runs. Machine: {machine}. Wall time of this command {wall_s / 60:.1f} min "
+        f"({ran_now} runs now, the rest resumed); run time summed over all runs "
+        f"{run_wall / 60:.1f} min.",
+        "",
+        f"Scored by the official rating calculator euroncap-rating-2026 {version} "
+        "(`crash_avoidance generate-template`, `preprocess`, `compute-score`; files in "
+        f"`{out.name}/calculator/`). Protocol: {protocol.protocol}.",
+        "",
+        "## Points (the calculator's compute-score)",
+        "",
+        "Per load case: standard + extended + robustness points of the calculator's Scenario "
+        "Scores over their maximum (day and night together: the night half is not run).",
+        "",
+        score_table(scores, {protocol.tests[t].load_case.split(" ")[0] for t in tests}),
+        "",
+        f"Left unscored: {left_unscored}.",
+        "",
+    ]
+    for policy, name in pictures:
+        lines += [f"![{policy} colour matrices]({name})", ""]
+    lines += [
+        "## Verification tests the calculator chose",
+        "",
+        "The calculator's preprocess picks the points (its own random choice, seeded); each "
+        "gets the value of the point's independent verification run; Colour is the colour "
+        "compute-score applied.",
+        "",
+    ]
+    for policy, s in scores.items():
+        lines += [f"**{policy}**", "", "| load case | function | speed | impact | prediction "
+                  "| value | expected | colour |", "|" + " --- |" * 8]  # fmt: skip
+        for v in s.verification:
+            lines.append(
+                f"| {v.get('Scenario')} | {v.get('Function') or 'AEB'} | {v.get('VUT speed')} "
+                f"| {v.get('Impact location')} | {v.get('OEM Prediction')} | {v.get('Value')} "
+                f"| {v.get('Expected value')} | {v.get('Colour')} |"
+            )
+        lines.append("")
+    lines += ["## Per grid point", ""]
+    for policy in scores:
+        warned, n, lead = recall_lead(rows, policy)
+        lines += [
+            f"**{policy}**: warned in {warned} of {n} grid runs, median warning TTC "
+            f"{_f(lead, '.2f')} s.",
+            "",
+            points_table(points, policy),
+            "",
+        ]
+    lines += [
+        "## Unnecessary braking on car-scale near misses",
+        "",
+        "| policy | runs | braked (unnecessary) | warned | contacts |",
+        "|" + " --- |" * 5,
+    ]
+    for nm in near_misses(rows):
+        lines.append(f"| {nm.policy} | {nm.runs} | {nm.braked} | {nm.warned} | {nm.contacts} |")
+    lines += [
+        "",
+        "## How the runs were made",
+        "",
+        f"- Timing: each run starts {t.impact_time:g} s before the nominal impact (T0 = TTC "
+        f"{t.steady_state_ttc:g} s of the protocol plus {t.acquisition:g} s for the pipeline to "
+        f"acquire), {t.fps:g} frames/s.",
+        f"- Tolerances drawn per run: car speed +{tol.vut_speed_kmh[0]:g}..+"
+        f"{tol.vut_speed_kmh[1]:g} km/h, car path +-{tol.vut_lateral:g} m, target speed "
+        f"+-{tol.target_speed_kmh:g} km/h, target path +-{tol.target_lateral:g} m, impact point "
+        f"+-{tol.impact_point:g} m.",
+        f"- AEB: brakes on the first warning after the pipeline's "
+        f"{'measured latency' if car.latency_ms is None else f'fixed {car.latency_ms:g} ms'} "
+        f"plus {car.brake_delay:g} s, building up at {car.jerk:g} m/s^3 to {car.deceleration:g} "
+        f"m/s^2; FCW = that warning. Body pitch {car.pitch.gain:g} deg per m/s^2 at "
+        f"{car.pitch.frequency:g} Hz, damping {car.pitch.damping:g} (the camera and the truth "
+        "dip; the pipeline keeps its nominal camera).",
+        "- Prediction per grid point: the calculator's colour band of the worst grid run; "
+        "verification value: the verification run. Cells not run: Red (no claim).",
+        f"- Sources of every figure: `{protocol.path}` and `{car.path}` (comments).",
+        "",
+    ]
+    return "\n".join(lines)

@@ -1,0 +1,202 @@
+"""`monopic ncap`: the Euro NCAP 2026 pedestrian grid at car scale, scored by the calculator."""
+
+from __future__ import annotations
+
+import argparse
+import os
+import platform
+import shutil
+import time
+from pathlib import Path
+
+from monopic.errors import UserError
+from monopic.output import write_text_atomically
+
+PROTOCOL = Path("scenarios/ncap/protocol.toml")
+CAR = Path("scenarios/ncap/car.toml")
+LEFT_UNSCORED = (
+    "CPNA, CPFA, CPNCO and CPLA at night (their night matrices are filled Red: not run, "
+    "no claim); CPTA (turning: needs a robot that turns and a truth that follows it); the "
+    "extended range (impact locations outside the standard range, filled Red); the "
+    "robustness layers (all claimed NO); every cyclist, car and motorcycle load case (not "
+    "claimed)"
+)
+
+
+def register(sub: argparse._SubParsersAction) -> None:
+    p = sub.add_parser(
+        "ncap",
+        help="Euro NCAP 2026 pedestrian tests at car scale, scored by the official calculator",
+        description="Run the Euro NCAP 2026 pedestrian frontal-collision grid (CPNA, CPFA, "
+        "CPNCO, CPLA; day) at car scale in closed loop: the car brakes on the pipeline's "
+        "warning after its measured latency and a brake delay, jerk-limited, its camera "
+        "dipping as it brakes; every grid point is run with jittered seeds (worst and mean "
+        "reported) plus an independent verification run; car-scale near misses beside. "
+        "Then the official rating calculator (extra [ncap]) scores it: generate-template, "
+        "preprocess, compute-score. Writes DIR/results.jsonl (resumable), DIR/report.md, "
+        "its matrix pictures and DIR/calculator/*.xlsx. Protocol and car: "
+        f"{PROTOCOL}, {CAR}.",
+    )
+    p.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
+    p.add_argument("--tests", default="cpna,cpfa,cpnco,cpla", help="default: all four")
+    p.add_argument("--quick", action="store_true", help="the thin grid (CI and the demo)")
+    p.add_argument("--speeds", help="only these car speeds, km/h, e.g. 20,40")
+    p.add_argument("--policies", help="default: the car file's (--quick: its primary)")
+    p.add_argument(
+        "--seeds", type=int, help="jittered runs per grid point (default: the car file's)"
+    )
+    p.add_argument("--no-near-misses", action="store_true", help="skip the near misses")
+    p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    p.add_argument("--executor", choices=("local", "ray"), default="local")
+    p.add_argument("--address", help="Ray cluster address (--executor ray)")
+    p.add_argument("--restart", action="store_true", help="set aside other code's results")
+    p.add_argument("--protocol", type=Path, default=PROTOCOL, help=argparse.SUPPRESS)
+    p.add_argument("--car", type=Path, default=CAR, help=argparse.SUPPRESS)
+    p.set_defaults(func=run)
+
+
+def _speeds(text: str | None) -> list[float] | None:
+    if text is None:
+        return None
+    try:
+        values = [float(v) for v in text.split(",") if v.strip()]
+    except ValueError:
+        raise UserError(
+            f"--speeds: expected km/h numbers separated by commas, got {text!r}"
+        ) from None
+    if not values:
+        raise UserError(f"--speeds: expected km/h numbers separated by commas, got {text!r}")
+    return values
+
+
+def run(args: argparse.Namespace) -> int:
+    # Everything is checked before anything is written.
+    from sim.analysis.ncap_score import require_calculator
+    from sim.scenario.ncap import load_car, load_protocol
+
+    version = require_calculator()
+    protocol = load_protocol(args.protocol)
+    car = load_car(args.car)
+    tests = [t.strip().lower() for t in args.tests.split(",") if t.strip()]
+    for t in tests:
+        if t not in protocol.tests:
+            raise UserError(
+                f"--tests: unknown test {t!r} (known: {', '.join(protocol.tests)}; night and "
+                "turning tests are not in this grid)"
+            )
+    if not tests:
+        raise UserError("--tests: name at least one test")
+    speeds = _speeds(args.speeds)
+    if speeds is not None:
+        for v in speeds:
+            ranges = [protocol.tests[t].speed_range for t in tests]
+            known = {s for t in tests for row in protocol.tests[t].rows for s in row.speeds_kmh}
+            if v not in known:
+                spans = ", ".join(
+                    f"{t} {lo:g}-{hi:g}" for t, (lo, hi) in zip(tests, ranges, strict=True)
+                )
+                raise UserError(
+                    f"--speeds {v:g}: not a test speed of the protocol's grid ({spans} km/h "
+                    "in 10 km/h steps)"
+                )
+    default = (car.primary,) if args.quick else car.policies  # quick: the primary only
+    policies = default if args.policies is None else tuple(
+        p.strip() for p in args.policies.split(",") if p.strip()
+    )  # fmt: skip
+    from monopic.predict.base import Mode
+    from monopic.predict.registry import predictor_names
+
+    for policy in policies:
+        name, _, mode = policy.partition("/")
+        if mode not in {m.value for m in Mode} or name not in predictor_names():
+            raise UserError(f"--policies: {policy!r} is not PREDICTOR/MODE "
+                            f"({', '.join(predictor_names())}; image or ground)")  # fmt: skip
+    if args.seeds is not None and args.seeds < 1:
+        raise UserError(f"--seeds: at least 1, got {args.seeds}")
+    if args.workers is not None and args.workers < 1:
+        raise UserError(f"--workers: at least 1, got {args.workers}")
+    if not args.out.parent.is_dir():
+        raise UserError(f"{args.out}: its folder {args.out.parent} does not exist")
+    if args.out.exists() and not args.out.is_dir():
+        raise UserError(f"{args.out}: exists and is not a folder")
+
+    from sim.analysis import ncap_report as rep
+    from sim.analysis.ncap_score import score
+    from sim.runs import ncap_grid
+    from sim.runs.executors import local_executor, ray_executor
+
+    runs = ncap_grid.expand(
+        protocol, car, tests, list(policies), quick=args.quick, speeds=speeds,
+        seeds=args.seeds, near_misses=not args.no_near_misses,
+    )  # fmt: skip
+    args.out.mkdir(exist_ok=True)
+    results = args.out / "results.jsonl"
+    ncap_grid.check_results(results, args.restart)
+    if args.executor == "ray":
+        executor = ray_executor(args.address, run=ncap_grid.work)
+    else:
+        executor = local_executor(args.workers, run=ncap_grid.work)
+    t0 = time.perf_counter()
+    outcome = ncap_grid.run_grid(runs, results, executor)
+    wall = time.perf_counter() - t0
+    if outcome.failed:
+        raise UserError(
+            f"{len(outcome.failed)} runs failed (first: {outcome.failed[0][0]}); "
+            f"{results} keeps the others: run the same command to retry them"
+        )
+    rows = ncap_grid.read_results(results, runs)
+    points = rep.summarise(rows)
+    claimed = {protocol.tests[t].load_case.split(" ")[0] for t in tests}
+    scores = {}
+    for policy in policies:
+        folder = args.out / "calculator" / policy.replace("/", "-")
+        if folder.exists():
+            shutil.rmtree(folder)
+        scores[policy] = score(folder, rep.cells(points, policy), claimed)
+    pictures = []
+    for policy in policies:
+        name = f"matrix-{policy.replace('/', '-')}.png"
+        rep.plot_matrices(protocol, points, policy, tests, args.out / name)
+        pictures.append((policy, name))
+    machine = (
+        f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
+        f"host {platform.node()}"
+    )
+    text = rep.render(
+        protocol=protocol,
+        car=car,
+        tests=tests,
+        quick=args.quick,
+        speeds=speeds,
+        seeds=args.seeds or (car.quick_seeds if args.quick else car.seeds),
+        rows=rows,
+        points=points,
+        scores=scores,
+        pictures=pictures,
+        command=_command(args),
+        machine=machine,
+        wall_s=wall,
+        ran_now=outcome.finished,
+        version=version,
+        left_unscored=LEFT_UNSCORED,
+        out=args.out,
+    )
+    write_text_atomically(args.out / "report.md", text)
+    print(rep.score_table(scores, claimed))
+    print(f"report: {args.out / 'report.md'}")
+    return 0
+
+
+def _command(args: argparse.Namespace) -> str:
+    parts = ["monopic ncap"]
+    if args.tests != "cpna,cpfa,cpnco,cpla":
+        parts.append(f"--tests {args.tests}")
+    if args.quick:
+        parts.append("--quick")
+    for flag in ("speeds", "policies", "seeds", "workers"):
+        if getattr(args, flag) is not None:
+            parts.append(f"--{flag} {getattr(args, flag)}")
+    if args.no_near_misses:
+        parts.append("--no-near-misses")
+    parts.append(f"--out {args.out}")
+    return " ".join(parts)

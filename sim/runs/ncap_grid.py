@@ -1,0 +1,221 @@
+"""The Euro NCAP grid as runs: expand it, run what a results file lacks, one line per run.
+
+Every grid point (sim.scenario.ncap) is run `car.seeds` times with jittered deviations
+(role "grid": the manufacturer's virtual tests its prediction comes from) and
+`car.verification_seeds` more times with further draws (role "verify": the test lab's
+verification run the calculator compares the prediction against), once per policy; the
+car-scale near misses are run beside them (role "near-miss"). A run's id is its policy,
+grid point, role, draw number and scenario digest, so re-expanding finds the same runs
+and a results file resumes as a sweep's does (sim.runs.results_file: one fsynced JSON
+line per finished run, the code version on every line). Runs execute on the sweep
+executors (sim.runs.executors: local spawned workers or Ray).
+"""
+
+from __future__ import annotations
+
+import platform
+import sys
+import time
+import traceback
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+from tqdm import tqdm
+
+from monopic.errors import UserError
+from sim.runs.aeb import AebParams, run_aeb
+from sim.runs.code_version import code_version
+from sim.runs.results_file import ResultsWriter, read_rows, scan
+from sim.scenario.files import load
+from sim.scenario.ncap import (
+    KMH,
+    CarSpec,
+    GridPoint,
+    Protocol,
+    draw_for,
+    grid,
+    scenario_digest,
+    scenario_for,
+)
+from sim.scenario.spec import Scenario
+from sim.world.render import KeptRenderContext
+
+SCHEMA = 1
+GRID, VERIFY, NEAR_MISS = "grid", "verify", "near-miss"
+
+
+@dataclass(frozen=True)
+class NcapRun:
+    """One closed-loop run as a worker receives it (plain, picklable data)."""
+
+    id: str
+    scenario: Scenario
+    policy: str
+    aeb: AebParams
+    role: str  # GRID, VERIFY or NEAR_MISS
+    index: int  # draw number (near misses: seed number)
+    meta: dict[str, Any] = field(default_factory=dict)  # test, function, speed, impact, draw
+    code: str = ""
+
+
+def aeb_params(car: CarSpec) -> AebParams:
+    return AebParams(car.brake_delay, car.jerk, car.deceleration, car.latency_ms)
+
+
+def expand(
+    protocol: Protocol,
+    car: CarSpec,
+    tests: list[str],
+    policies: list[str],
+    *,
+    quick: bool = False,
+    speeds: list[float] | None = None,
+    seeds: int | None = None,
+    near_misses: bool = True,
+) -> list[NcapRun]:
+    """Every run of the grid, in a stable order (policy, point, role, draw)."""
+    aeb = aeb_params(car)
+    n_grid = (car.quick_seeds if quick else car.seeds) if seeds is None else seeds
+    points = grid(protocol, tests, quick, speeds)
+    runs = []
+    for policy in policies:
+        for point in points:
+            roles = [(GRID, k) for k in range(n_grid)]
+            roles += [(VERIFY, n_grid + k) for k in range(car.verification_seeds)]
+            for role, k in roles:
+                d = draw_for(protocol.tolerances, point.id, k)
+                scenario = scenario_for(protocol, car, point, d, seed=k)
+                meta = {**asdict(point), "draw": asdict(d), "load_case": _case(protocol, point)}
+                runs.append(_run(policy, point.id, role, k, scenario, aeb, meta))
+        if near_misses:
+            runs.extend(_near_misses(protocol, car, policy, aeb, quick, speeds))
+    return runs
+
+
+def _case(protocol: Protocol, point: GridPoint) -> str:
+    return protocol.tests[point.test].load_case
+
+
+def _run(policy: str, key: str, role: str, k: int, s: Scenario, aeb: AebParams,
+         meta: dict[str, Any]) -> NcapRun:  # fmt: skip
+    rid = f"{policy}/{key}/{role}{k}-{scenario_digest(s)}"
+    return NcapRun(rid, replace(s, name=rid), policy, aeb, role, k, meta)
+
+
+def _near_misses(
+    protocol: Protocol, car: CarSpec, policy: str, aeb: AebParams, quick: bool,
+    speeds: list[float] | None,
+) -> list[NcapRun]:  # fmt: skip
+    nm = protocol.near_misses
+    out = []
+    for path in nm.files:
+        sf = load(path)
+        for v in nm.quick_speeds_kmh if quick else nm.speeds_kmh:
+            if speeds is not None and v not in speeds:
+                continue
+            base = sf.scenario({"robot.speed": v * KMH}, name=sf.name)
+            robot = replace(base.robot, max_deceleration=car.deceleration, pitch=car.pitch)
+            for k in range(nm.quick_seeds if quick else nm.seeds):
+                s = replace(base, robot=robot, seed=k)
+                meta = {"test": "near-miss", "family": sf.name, "speed_kmh": v}
+                out.append(_run(policy, f"{sf.name}/{v:g}kmh", NEAR_MISS, k, s, aeb, meta))
+    return out
+
+
+def work(spec: NcapRun, kept: KeptRenderContext | None = None) -> dict[str, Any]:
+    """One run in a worker: its result line, or {"id", "error"} (the grid goes on)."""
+    try:
+        camera = spec.scenario.robot.camera
+        context = kept.fitting(camera.width, camera.height) if kept is not None else None
+        t0 = time.perf_counter()
+        outcome = run_aeb(
+            spec.scenario, spec.policy, spec.aeb, seed=spec.index, render_context=context
+        )
+        return {
+            "schema": SCHEMA,
+            "id": spec.id,
+            "code": spec.code,
+            "policy": spec.policy,
+            "role": spec.role,
+            "index": spec.index,
+            **spec.meta,
+            "outcome": asdict(outcome),
+            "wall_s": round(time.perf_counter() - t0, 3),
+            "machine": {"host": platform.node(), "cpu": platform.processor() or "?"},
+        }
+    except Exception:  # noqa: BLE001 - reported per run
+        return {"id": spec.id, "error": traceback.format_exc()}
+
+
+Executor = Callable[[Sequence[NcapRun], Callable[[dict[str, Any]], None]], None]
+
+
+@dataclass(frozen=True)
+class GridOutcome:
+    total: int
+    skipped: int
+    finished: int
+    failed: tuple[tuple[str, str], ...]
+    seconds: float
+
+
+def check_results(out: Path, restart: bool) -> None:
+    """Refuse (one line) a results file of other code unless `restart` sets it aside."""
+    if not out.exists():
+        return
+    code = code_version()
+    state = scan(out)
+    other = state.other_code(code)
+    if other and not restart:
+        raise UserError(
+            f"{out}: holds runs of other code ({', '.join(other)}; this code is {code}); "
+            "use another --out, or --restart to set them aside and start over"
+        )
+    if other:
+        tag = next(iter(other)) if len(other) == 1 else "mixed"
+        target = out.with_name(f"{out.stem}.{tag}{out.suffix}")
+        if target.exists():
+            raise UserError(f"{target}: already there; move it away to restart {out}")
+        out.rename(target)
+        print(f"set aside: {out} -> {target}", file=sys.stderr)
+
+
+def run_grid(
+    runs: list[NcapRun], out: Path, executor: Executor, progress: bool = True
+) -> GridOutcome:
+    """Run every run missing from `out`, appending each result line as it finishes."""
+    code = code_version()
+    runs = [replace(r, code=code) for r in runs]
+    with ResultsWriter(out) as writer:
+        todo = [r for r in runs if r.id not in writer.state.ids]
+        skipped = len(runs) - len(todo)
+        if skipped and progress:
+            print(f"{out}: {skipped} of {len(runs)} runs already there, running the other "
+                  f"{len(todo)}", file=sys.stderr)  # fmt: skip
+        failed: list[tuple[str, str]] = []
+        finished = 0
+        start = time.perf_counter()
+        with tqdm(total=len(todo), unit="run", desc="ncap", disable=not progress) as bar:
+
+            def on_result(row: dict[str, Any]) -> None:
+                nonlocal finished
+                if "error" in row:
+                    failed.append((row["id"], row["error"]))
+                    bar.write(f"run {row['id']} failed: {row['error'].strip().splitlines()[-1]}")
+                else:
+                    writer.append(row)
+                    finished += 1
+                bar.update(1)
+
+            if todo:
+                executor(todo, on_result)
+    return GridOutcome(len(runs), skipped, finished, tuple(failed), time.perf_counter() - start)
+
+
+def read_results(out: Path, runs: list[NcapRun]) -> list[dict[str, Any]]:
+    """The result lines of `runs` (this code's), in the runs' order."""
+    wanted = {r.id for r in runs}
+    rows = {row["id"]: row for row in read_rows(out) if row["id"] in wanted}
+    return [rows[r.id] for r in runs if r.id in rows]
