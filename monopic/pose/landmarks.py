@@ -1,4 +1,4 @@
-"""BlazePose full landmark model (pose_landmark_full.onnx) run on a rotated region.
+"""BlazePose landmark model (lite, full or heavy; full by default) run on a rotated region.
 
 The model sees the region as 256x256 RGB in [0, 1] and returns 39 points x (x, y, z,
 visibility logit, presence logit) in crop pixels: the 33 landmarks, then auxiliary points
@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from monopic.pose.region import DEFAULT_SCALE, Region
-from monopic.pose.sessions import LANDMARK_FILE, make_session, model_path
+from monopic.pose.sessions import DEFAULT_LANDMARK_MODEL, landmark_file, make_session, model_path
 from monopic.pose.skeleton import NUM_LANDMARKS
 
 INPUT_SIZE = 256
@@ -60,9 +60,12 @@ class Pose:
 
 
 class LandmarkModel:
-    def __init__(self, threads: int = 1) -> None:
+    def __init__(self, threads: int = 1, model: str = DEFAULT_LANDMARK_MODEL) -> None:
+        # The three models share inputs and outputs; only size and accuracy differ.
+        self.model = model
+        file = landmark_file(model)
         # The one model of every tracked frame: its threads may spin (sessions.py).
-        self.session = make_session(model_path(LANDMARK_FILE), threads, spin=True)
+        self.session = make_session(model_path(file), threads, spin=True)
         self.input_name = self.session.get_inputs()[0].name
         # Outputs are told apart by shape: landmarks (1, 195), pose flag (1, 1), heatmap
         # (1, 64, 64, 39).
@@ -77,7 +80,7 @@ class LandmarkModel:
             elif len(out.shape) == 4 and out.shape[-1] == NUM_POINTS:
                 names["heatmap"] = out.name
         if missing := {"points", "flag", "heatmap"} - names.keys():
-            raise ValueError(f"{LANDMARK_FILE} lacks the {sorted(missing)} output(s)")
+            raise ValueError(f"{file} lacks the {sorted(missing)} output(s)")
         self.output_names = [names["points"], names["flag"], names["heatmap"]]
 
     def run(self, image: np.ndarray, region: Region) -> Pose:

@@ -12,7 +12,26 @@ from pathlib import Path
 import onnxruntime as ort
 
 DETECTOR_FILE = "pose_detection.onnx"
-LANDMARK_FILE = "pose_landmark_full.onnx"
+# MediaPipe's three landmark models (its model_complexity 0, 1, 2), all converted by
+# `make models` from MediaPipe's own files (monopic/pose/models/NOTICE.md says where each
+# comes from). Full is the one the paper and MediaPipe's Pose solution use by default.
+LANDMARK_MODELS = {
+    "lite": "pose_landmark_lite.onnx",
+    "full": "pose_landmark_full.onnx",
+    "heavy": "pose_landmark_heavy.onnx",
+}
+DEFAULT_LANDMARK_MODEL = "full"
+LANDMARK_FILE = LANDMARK_MODELS[DEFAULT_LANDMARK_MODEL]
+
+
+def landmark_file(model: str) -> str:
+    """The shipped file of landmark model `model` (lite, full or heavy)."""
+    try:
+        return LANDMARK_MODELS[model]
+    except KeyError:
+        raise ValueError(
+            f"unknown landmark model {model!r}: choose one of {', '.join(LANDMARK_MODELS)}"
+        ) from None
 
 
 def model_path(name: str) -> Path:
