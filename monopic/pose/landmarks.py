@@ -68,7 +68,7 @@ class LandmarkModel:
         self.session = make_session(model_path(file), threads, spin=True)
         self.input_name = self.session.get_inputs()[0].name
         # Outputs are told apart by shape: landmarks (1, 195), pose flag (1, 1), heatmap
-        # (1, 64, 64, 39).
+        # (1, 39, 64, 64): channels first, as the converted files keep it (NOTICE.md).
         names: dict[str, str] = {}
         for out in self.session.get_outputs():
             dims = [d for d in out.shape if isinstance(d, int)]
@@ -77,7 +77,7 @@ class LandmarkModel:
                 names["points"] = out.name
             elif size == 1:
                 names["flag"] = out.name
-            elif len(out.shape) == 4 and out.shape[-1] == NUM_POINTS:
+            elif len(out.shape) == 4 and out.shape[1] == NUM_POINTS:
                 names["heatmap"] = out.name
         if missing := {"points", "flag", "heatmap"} - names.keys():
             raise ValueError(f"{file} lacks the {sorted(missing)} output(s)")
@@ -88,7 +88,8 @@ class LandmarkModel:
         tensor = crop.astype(np.float32) * (1.0 / 255.0)
         points, flag, heatmap = self.session.run(self.output_names, {self.input_name: tensor[None]})
         pts = points.reshape(NUM_POINTS, 5).astype(np.float64)
-        pts[:, :2] = refine_from_heatmap(pts[:, :2], heatmap[0], INPUT_SIZE)
+        # (H, W, C) view of the channels-first map: no copy, the refinement gathers 7x7.
+        pts[:, :2] = refine_from_heatmap(pts[:, :2], heatmap[0].transpose(1, 2, 0), INPUT_SIZE)
         xy = region.to_image(pts[:, :2], INPUT_SIZE)
         z = pts[:, 2] * (region.side / INPUT_SIZE)
         lm = np.column_stack([xy[:NUM_LANDMARKS], z[:NUM_LANDMARKS]])

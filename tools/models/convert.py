@@ -11,7 +11,9 @@ Run through ``make models`` (which provides the pinned conversion venv). Steps:
 3. Convert the models with tf2onnx at a pinned opset, then give inputs/outputs
    descriptive names, prune the landmark model to the outputs monopic reads (landmarks,
    pose flag, heatmap; onnxruntime would otherwise run the segmentation and world
-   landmark branches on every frame), store the (exactly fp16) weights as fp16, and
+   landmark branches on every frame), fold the input Pad into the first Conv and leave
+   the heatmap channels-first (two kernels less per frame, same values), store the
+   (exactly fp16) weights as fp16, and
    derive node names/order from the graph and fix all strings, so that two runs
    produce byte-identical files.
 4. Run the ORIGINAL TFLite models (sparse detector included) on a few fixed inputs
@@ -45,7 +47,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from densify import densify  # noqa: E402
 from onnx_post import (  # noqa: E402
     canonicalize,
+    fold_pad_into_conv,
     keep_outputs,
+    output_channels_first,
     rename_values,
     stamp,
     store_fp16_weights,
@@ -236,14 +240,20 @@ def to_onnx(spec: ModelSpec, tflite: Path, source: Path) -> tuple[onnx.ModelProt
             f"({convs - count_ops(model, 'Conv')} of {convs} convolutions)"
         )
         print(f"{spec.name}: pruned to {', '.join(spec.keep)}: {pruned}")
+    # Layout clean-ups the landmark model's profile pointed to (bench/landmark_profile.py);
+    # both leave every output value as it was (tests/test_model_fidelity.py).
+    print(f"{spec.name}: {fold_pad_into_conv(model)} Pad(s) folded into the first Conv")
+    for name in CHANNELS_FIRST:
+        if name in spec.shipped and output_channels_first(model, name):
+            print(f"{spec.name}: `{name}` left channels-first (its Transpose dropped)")
     print(f"{spec.name}: {store_fp16_weights(model)} weight tensors stored as fp16")
     canonicalize(model)
     stamp(
         model,
-        doc=f"MediaPipe {Path(spec.member).name} from {MEDIAPIPE} (Apache-2.0); see NOTICE.md",
+        doc=f"MediaPipe {Path(spec.member).name} from {spec.package} (Apache-2.0); see NOTICE.md",
         metadata={
             "name": spec.name,
-            "source": f"{MEDIAPIPE} wheel: {spec.member}",
+            "source": f"{spec.package}: {spec.member}",
             "source_sha256": sha256(source.read_bytes()),
             "license": "Apache-2.0",
         },
@@ -320,6 +330,9 @@ FIXTURE_DOC = (
 )
 # Spatial subsampling of the big per-pixel outputs in the fixture (NHWC, H and W axes).
 FIXTURE_STRIDES = {"heatmap": 2}
+# Outputs the shipped files give channels-first (NCHW) where TFLite has NHWC; the fixture
+# keeps TFLite's layout.
+CHANNELS_FIRST = ("heatmap",)
 
 
 def build_fixture(sources: dict[str, Path], photo_jpeg: bytes) -> dict[str, np.ndarray]:
@@ -366,6 +379,8 @@ def onnx_max_diffs(
         for name, got in zip(shipped, outs, strict=True):
             key = f"{spec.name}.{name}"
             ref = fixture[key][k]
+            if name in CHANNELS_FIRST:
+                got = got.transpose(0, 2, 3, 1)  # back to TFLite's NHWC
             if f"{key}.stride" in fixture:
                 stride = int(fixture[f"{key}.stride"])
                 got = got[:, ::stride, ::stride]
@@ -458,6 +473,11 @@ sha256 values above, and:
   keeps the same nodes as `onnx.utils.extract_model`) only removes nodes, so the kept
   outputs are computed exactly as in the full conversion. It keeps {keep}; for the
   full model it {pruned};
+- folds the zero Pad that tf2onnx writes before the first, strided convolution (Pad ->
+  Transpose -> Conv, which onnxruntime cannot fuse across the Transpose) into that
+  Conv's padding, and drops the Transpose that turned the landmark models' heatmap back
+  to NHWC (`heatmap` is channels-first); the profile in `bench/landmark_profile.py`
+  showed both as kernels of their own on every frame; the outputs keep their values;
 - writes `tests/data/pose_reference.npz` with the ORIGINAL TFLite models' outputs on
   fixed inputs (the outputs the ONNX files keep), checked by
   `tests/test_model_fidelity.py`. One input is the public domain Grace Hopper
@@ -499,7 +519,9 @@ outputs below.
   keypoints 0 and 1); 35-38 are unused by MediaPipe.
 - `pose_flag` [1, 1]: probability that a pose is present (the graph ends in a
   Sigmoid; MediaPipe's threshold is 0.5).
-- `heatmap` [1, 64, 64, 39]: per-landmark heatmap logits, used by MediaPipe's
+- `heatmap` [1, 39, 64, 64]: per-landmark heatmap logits, channels first (TFLite's
+  output is [1, 64, 64, 39]; the converter drops the Transpose to it, a kernel of its
+  own on every frame), used by MediaPipe's
   heatmap refinement step (which applies a sigmoid; monopic does the same step in
   `monopic/pose/landmarks.py`).
 
