@@ -26,6 +26,9 @@ NARRATIVE = "docs/benchmarks.md"
 # Sections in this order; benchmarks not listed follow by name.
 ORDER = (
     "compare_reference",
+    "landmark_profile",
+    "model_choices",
+    "int8_landmarks",
     "pipeline_latency",
     "post_pose",
     "simulator",

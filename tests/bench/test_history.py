@@ -266,7 +266,9 @@ def test_benchmarks_md_shows_goals_latest_results_and_flags() -> None:
 
 def test_a_goal_without_a_run_says_so() -> None:
     text = render([bench_run("simulator", "2026-11-23T09:40:00Z", scenario(12.0), "T")], HISTORY)
-    assert text.count("| not measured yet | - | no `compare_reference` run |") == 3
+    compare_goals = sum(goal.benchmark == "compare_reference" for goal in GOALS)
+    assert compare_goals == 5  # 1 and 2 threads, CPU-seconds at 1 and 2, landmark error
+    assert text.count("| not measured yet | - | no `compare_reference` run |") == compare_goals
     assert "| 12.0 fps (11.5-12.5 over 4 runs) | no |" in text
     assert "No runs in `bench/history.jsonl` yet" in render([], HISTORY)
 
