@@ -9,7 +9,11 @@ is NOT shipped unless the judge says it keeps the float model's landmark error (
 
     .venv-models/bin/python tools/models/quantize.py --crops recordings/int8/calibration.npz \
         --out recordings/int8/pose_landmark_full_int8.onnx [--method minmax|percentile|entropy]
-        [--float-last N]
+        [--deep-only PX]
+
+--deep-only PX quantizes only the convolutions whose output is at most PX pixels on a side
+(the deep, many-channel layers, where int8 kernels gain most), keeping the early
+high-resolution layers, the decoder and the heads in float.
 """
 
 from __future__ import annotations
@@ -21,7 +25,7 @@ from pathlib import Path
 
 import numpy as np
 import onnx
-from onnx import numpy_helper
+from onnx import numpy_helper, shape_inference
 from onnxruntime.quantization import (
     CalibrationDataReader,
     CalibrationMethod,
@@ -76,9 +80,7 @@ def main() -> int:
     ap.add_argument("--crops", type=Path, required=True)
     ap.add_argument("--out", type=Path, required=True)
     ap.add_argument("--method", choices=list(METHODS), default="minmax")
-    ap.add_argument(
-        "--float-last", type=int, default=0, help="keep the last N convolutions in float"
-    )
+    ap.add_argument("--deep-only", type=int, default=0, help="quantize only convs <= PX wide")
     args = ap.parse_args()
     if not args.crops.is_file():
         raise SystemExit(f"quantize: --crops {args.crops}: no such file")
@@ -86,8 +88,13 @@ def main() -> int:
         crops = data["crops"]
     model = onnx.load(FLOAT_MODEL)
     print(f"{float32_weights(model)} fp16 weight tensors turned into float32")
-    convs = [n.name for n in model.graph.node if n.op_type == "Conv"]
-    exclude = convs[len(convs) - args.float_last :] if args.float_last else []
+    inferred = shape_inference.infer_shapes(model)
+    side = {
+        v.name: v.type.tensor_type.shape.dim[-1].dim_value
+        for v in [*inferred.graph.value_info, *inferred.graph.output]
+    }
+    convs = [n for n in model.graph.node if n.op_type == "Conv"]
+    exclude = [n.name for n in convs if args.deep_only and side[n.output[0]] > args.deep_only]
     args.out.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
         src = Path(tmp) / "float32.onnx"
