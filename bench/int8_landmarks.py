@@ -51,7 +51,7 @@ def tracker_with(path: Path | None, threads: int = 1) -> PoseTracker:
     """The shipped tracker; with `path`, its landmark session runs that file instead."""
     tracker = PoseTracker(TrackerConfig(threads=threads))
     if path is not None:
-        session = make_session(path, threads, spin=True)
+        session = make_session(path, threads, spin=False)
         names = {o.name for o in session.get_outputs()}
         if missing := set(tracker.landmarks.output_names) - names:
             raise SystemExit(f"int8_landmarks: {path} lacks the output(s) {sorted(missing)}")
@@ -105,7 +105,7 @@ def model_times(
     paths: dict[str, Path], crops: np.ndarray, threads: int, rounds: int
 ) -> dict[str, Any]:
     """Median ms per run of each model on the same crops, alternated (A B B A ...)."""
-    sessions = {k: make_session(p, threads, spin=True) for k, p in paths.items()}
+    sessions = {k: make_session(p, threads, spin=False) for k, p in paths.items()}
     feeds = [{"image": (c.astype(np.float32) / 255.0)[None]} for c in crops]
     for s in sessions.values():
         for f in feeds[:5]:

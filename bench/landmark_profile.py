@@ -173,8 +173,10 @@ def op_profile(path: Path, threads: int, runs: int) -> Profile:
 
 
 def variants(full: Path, threads: int, candidates: list[Path], work: Path) -> dict[str, Any]:
-    """Sessions to alternate: shipped, no NCHWc, ORT format, and the candidates."""
-    out: dict[str, Any] = {"shipped": make_session(full, threads, spin=True)}
+    """Sessions to alternate: shipped, spinning, no NCHWc, ORT format, and the candidates."""
+    out: dict[str, Any] = {"shipped": make_session(full, threads, spin=False)}
+    if threads > 1:
+        out["spinning intra-op threads"] = make_session(full, threads, spin=True)
     ext = ort.SessionOptions()
     ext.intra_op_num_threads = threads
     ext.inter_op_num_threads = 1
@@ -187,9 +189,9 @@ def variants(full: Path, threads: int, candidates: list[Path], work: Path) -> di
     save.optimized_model_filepath = str(ort_file)
     save.add_session_config_entry("session.save_model_format", "ORT")
     ort.InferenceSession(str(full), save, providers=["CPUExecutionProvider"])
-    out["ORT format (optimised graph saved)"] = make_session(ort_file, threads, spin=True)
+    out["ORT format (optimised graph saved)"] = make_session(ort_file, threads, spin=False)
     for path in candidates:
-        out[path.name] = make_session(path, threads, spin=True)
+        out[path.name] = make_session(path, threads, spin=False)
     return out
 
 
@@ -231,7 +233,7 @@ def measure(threads: int, rounds: int, candidates: list[Path], frames: list[Any]
     dense_x = {"x": np.random.default_rng(0).random(DENSE_SHAPE, dtype=np.float32)}
     with tempfile.TemporaryDirectory() as tmp:
         sessions = variants(model_path(LANDMARK_MODELS["full"]), threads, candidates, Path(tmp))
-        dense = {k: make_session(p, threads, spin=True) for k, p in DENSE.items()}
+        dense = {k: make_session(p, threads, spin=False) for k, p in DENSE.items()}
         items: list[tuple[str, Any, dict[str, np.ndarray]]] = [
             *((k, s.run, feed) for k, s in sessions.items()),
             *((f"dense 3x3 conv {k}", s.run, dense_x) for k, s in dense.items()),

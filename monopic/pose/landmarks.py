@@ -64,8 +64,9 @@ class LandmarkModel:
         # The three models share inputs and outputs; only size and accuracy differ.
         self.model = model
         file = landmark_file(model)
-        # The one model of every tracked frame: its threads may spin (sessions.py).
-        self.session = make_session(model_path(file), threads, spin=True)
+        # No spinning, even though it runs every frame: on a shared host spinning threads
+        # cost far more than they save (sessions.py).
+        self.session = make_session(model_path(file), threads, spin=False)
         self.input_name = self.session.get_inputs()[0].name
         # Outputs are told apart by shape: landmarks (1, 195), pose flag (1, 1), heatmap
         # (1, 39, 64, 64): channels first, as the converted files keep it (NOTICE.md).
