@@ -164,9 +164,9 @@ def fold_pad_into_conv(model: onnx.ModelProto) -> int:
     Pad (NHWC) -> Transpose (to NCHW) -> Conv. onnxruntime fuses a Pad into the Conv that
     reads it directly, but not across the Transpose, so the first Pad ran as its own
     kernel over the whole 256x256x3 input on every frame (1.3 % of the landmark model's
-    kernel time, bench/landmark_profile.py). Rewired as Transpose -> Conv with the pad
-    amounts in the Conv's `pads` (permuted to NCHW), the outputs are the same. Returns
-    the number of Pads folded.
+    kernel time on a loaded host, bench/landmark_profile.py). Rewired as Transpose ->
+    Conv with the pad amounts in the Conv's `pads` (permuted to NCHW), the outputs are
+    the same. Returns the number of Pads folded.
     """
     graph = model.graph
     inits = {i.name: i for i in graph.initializer}
@@ -227,8 +227,10 @@ def output_channels_first(model: onnx.ModelProto, name: str) -> bool:
     """Drop the final NCHW -> NHWC Transpose in front of output `name` (True if dropped).
 
     The landmark model's heatmap leaves its last Conv as NCHW and tf2onnx transposes it
-    back to TFLite's NHWC, a kernel of its own on every frame (0.9 % of the kernel time);
-    monopic reads 7x7 windows of 35 channels, in any layout, so the output can stay NCHW.
+    back to TFLite's NHWC. monopic reads 7x7 windows of it, in any layout, so the output
+    can stay NCHW. (With its NCHWc layout onnxruntime already folds this Transpose into
+    the last layout reorder, so on such CPUs the saving is not measurable; the graph is
+    one node simpler wherever that transformer does not run.)
     """
     graph = model.graph
     node = next((n for n in graph.node if name in n.output), None)
