@@ -333,6 +333,23 @@ def main() -> None:
             f"| {row['macs'] / 1e6:.1f} | {rate} |"
         )
 
+    for path in args.candidate:  # e.g. an int8 model: which kernels it runs, and how long
+        p = op_profile(path, 1, args.profile_runs)
+        results["profile"] += [{"model": path.name, "threads": 1, **row} for row in p.rows]
+        lines += [
+            "",
+            f"Per-operator profile of `{path.name}`, 1 thread ({p.total_ms:.2f} ms kernel "
+            f"time per run against {profiles['full'].total_ms:.2f} ms for the full model "
+            "in the same minutes; quantised kernels take prepacked weights, so no MACs):",
+            "",
+            "| operator | nodes | ms per run | share |",
+            "| --- | ---: | ---: | ---: |",
+            *(
+                f"| {row['kind']} | {row['nodes']} | {row['ms']:.3f} | {row['share_pct']:.1f} % |"
+                for row in p.rows
+            ),
+        ]
+
     # 3 + 4: variants, the dense-conv rate and the pipeline, alternated.
     frames = clip_frames()
     lines += [
