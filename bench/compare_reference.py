@@ -74,10 +74,17 @@ def worker_command(side: str, ref_python: Path) -> tuple[list[str], dict[str, st
 
 
 def run_worker(
-    side: str, frames: Path, threads: int, warmup: int, ref_python: Path, pin: bool
+    side: str,
+    frames: Path,
+    threads: int,
+    warmup: int,
+    ref_python: Path,
+    pin: bool,
+    model: str = "full",
 ) -> Run:
     cmd, extra_env = worker_command(side, ref_python)
     cmd += ["--frames", str(frames), "--threads", str(threads), "--warmup", str(warmup)]
+    cmd += ["--model", model]
     if pin:
         cmd.append("--pin")
     env = dict(os.environ, **extra_env)

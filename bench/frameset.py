@@ -9,7 +9,12 @@ occluded; the clip's CSV has no occlusion, so there it is "in the image"), seque
 number and timestamp per frame. A sequence is a run of consecutive frames: trackers are
 reset at each sequence start.
 
-    .venv/bin/python bench/frameset.py [--out recordings/bench/frames]
+Other recipes (`Recipe`) build other sets the same way, each cached under its own
+digest: `LARGE` (issue 21: at least 500 frames on which an int8 landmark model must keep
+the float model's error) and `CALIBRATION` (other seeds and distances, the frames an int8
+model is calibrated on, so that it is never judged on them).
+
+    .venv/bin/python bench/frameset.py [--out recordings/bench/frames] [--recipe default]
 """
 
 from __future__ import annotations
@@ -36,6 +41,36 @@ RENDERED_FRAMES = 16
 
 
 @dataclass(frozen=True)
+class Recipe:
+    """Which frames a set holds: the clip (all of it, or its first `clip_frames`) and one
+    rendered World clip per (case, distance), seeded by distance, case and `seed`."""
+
+    name: str
+    cases: tuple[int, ...] = RENDERED_CASES
+    distances: tuple[float, ...] = RENDERED_DISTANCES
+    frames: int = RENDERED_FRAMES
+    seed: int = 0
+    clip_frames: int | None = None  # None: the whole clip
+
+    def digest_parts(self) -> list:
+        """What the cache digest covers; the default recipe keeps its original digest."""
+        parts: list = [CLIP.stat().st_size, self.cases, self.distances, self.frames, 1]
+        if (self.seed, self.clip_frames) != (0, None):
+            parts += [self.seed, self.clip_frames]
+        return parts
+
+
+DEFAULT = Recipe("default")
+# 600 frames: the clip and all nine cases at 3, 5 and 8 m, 20 frames each.
+LARGE = Recipe("large", cases=tuple(range(1, 10)), distances=(3.0, 5.0, 8.0), frames=20, seed=1)
+# 30 clip frames and eight cases at 4 and 7 m with other seeds: the int8 calibration set.
+CALIBRATION = Recipe(
+    "calibration", cases=tuple(range(1, 9)), distances=(4.0, 7.0), frames=10, seed=2, clip_frames=30
+)
+RECIPES = {r.name: r for r in (DEFAULT, LARGE, CALIBRATION)}
+
+
+@dataclass(frozen=True)
 class FrameSet:
     """Memory-mapped frames plus their truth; `sequences[k]` names sequence k."""
 
@@ -51,16 +86,13 @@ class FrameSet:
         return len(self.sequence)
 
 
-def spec_digest() -> str:
+def spec_digest(recipe: Recipe = DEFAULT) -> str:
     """Changes when the frame recipe changes, so a stale cache is rebuilt."""
-    recipe = json.dumps(
-        [CLIP.stat().st_size, RENDERED_CASES, RENDERED_DISTANCES, RENDERED_FRAMES, 1]
-    )
-    return hashlib.sha1(recipe.encode()).hexdigest()[:10]
+    return hashlib.sha1(json.dumps(recipe.digest_parts()).encode()).hexdigest()[:10]
 
 
-def paths(directory: Path) -> tuple[Path, Path]:
-    d = spec_digest()
+def paths(directory: Path, recipe: Recipe = DEFAULT) -> tuple[Path, Path]:
+    d = spec_digest(recipe)
     return directory / f"frames-{d}.npy", directory / f"frames-{d}.npz"
 
 
@@ -80,7 +112,7 @@ def _clip_frames() -> tuple[list[np.ndarray], np.ndarray, np.ndarray, np.ndarray
     return [f.image for f in frames], lm, vis, np.array([f.timestamp for f in frames])
 
 
-def _rendered(case: int, distance: float, frames: int):
+def _rendered(case: int, distance: float, frames: int, seed: int = 0):
     """One World clip: images, true pixels, visibility mask, timestamps."""
     from dataclasses import replace
 
@@ -96,7 +128,7 @@ def _rendered(case: int, distance: float, frames: int):
         robot_speed=0.0,
         duration=duration,
         meet_time=duration / 2,
-        seed=int(distance * 10) + case,
+        seed=int(distance * 10) + case + 1000 * seed,
     ).scenario()
     sc = replace(sc, name=f"case{case}@{distance:g}m")
     images, lms, vis, ts = [], [], [], []
@@ -111,14 +143,17 @@ def _rendered(case: int, distance: float, frames: int):
     return images, np.array(lms), np.array(vis), np.array(ts), sc.name
 
 
-def build(directory: Path = DEFAULT_DIR) -> tuple[Path, Path]:
+def build(directory: Path = DEFAULT_DIR, recipe: Recipe = DEFAULT) -> tuple[Path, Path]:
     """Decode and render the frame set unless the cache already has it; return its paths."""
-    npy, npz = paths(directory)
+    npy, npz = paths(directory, recipe)
     if npy.is_file() and npz.is_file():
         return npy, npz
     directory.mkdir(parents=True, exist_ok=True)
     images, lms, vis, seq, ts, dist, names = [], [], [], [], [], [], []
     im, lm, v, t = _clip_frames()
+    if recipe.clip_frames is not None:
+        k = recipe.clip_frames
+        im, lm, v, t = im[:k], lm[:k], v[:k], t[:k]
     images += im
     lms.append(lm)
     vis.append(v)
@@ -126,9 +161,9 @@ def build(directory: Path = DEFAULT_DIR) -> tuple[Path, Path]:
     seq += [0] * len(im)
     dist += [float("nan")] * len(im)
     names.append("walk_clip")
-    for case in RENDERED_CASES:
-        for distance in RENDERED_DISTANCES:
-            im, lm, v, t, name = _rendered(case, distance, RENDERED_FRAMES)
+    for case in recipe.cases:
+        for distance in recipe.distances:
+            im, lm, v, t, name = _rendered(case, distance, recipe.frames, recipe.seed)
             images += im
             lms.append(lm)
             vis.append(v)
@@ -170,8 +205,9 @@ def load(npy: Path, npz: Path) -> FrameSet:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--out", type=Path, default=DEFAULT_DIR)
+    ap.add_argument("--recipe", choices=list(RECIPES), default=DEFAULT.name)
     args = ap.parse_args()
-    npy, npz = build(args.out)
+    npy, npz = build(args.out, RECIPES[args.recipe])
     fs = load(npy, npz)
     print(f"{npy}: {len(fs)} frames, {len(fs.sequences)} sequences, {fs.images.shape}")
 

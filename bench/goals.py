@@ -3,9 +3,10 @@
 Issue 7's goals: the whole pipeline at most half the reference's per-frame time at the
 same thread count (1 and 2), landmark error equal or better (judged by the paired 95 %
 interval of bench/paired.py), and a scenario run on one core at least as fast as real
-time at 15 fps. A goal reads the structured results of bench/history.jsonl, never the
-Markdown, so the goal table cannot drift from the figures below it. A later goal is one
-more entry in GOALS.
+time at 15 fps. Issue 21 adds: at most half the reference's process CPU-seconds per frame,
+at 1 and at 2 threads, on the same frames and host. A goal reads the structured results
+of bench/history.jsonl, never the Markdown, so the goal table cannot drift from the
+figures below it. A later goal is one more entry in GOALS.
 """
 
 from __future__ import annotations
@@ -72,6 +73,23 @@ def cpu_ratio(results: dict[str, Any], threads: int) -> float | None:
     return per["ours"] / per["reference"]
 
 
+def cpu_ratio_at(threads: int) -> Callable[[dict[str, Any]], Standing | None]:
+    """Ours / reference in CPU-seconds per frame at `threads` threads, against RATIO_GOAL."""
+
+    def read(results: dict[str, Any]) -> Standing | None:
+        ratio = cpu_ratio(results, threads)
+        if ratio is None:
+            return None
+        per = {r["side"]: r for r in results["cpu"] if r["threads"] == threads}
+        return Standing(
+            f"{ratio:.2f} ({per['ours']['cpu_ms_per_frame']:.1f} vs "
+            f"{per['reference']['cpu_ms_per_frame']:.1f} CPU-ms per frame)",
+            ratio <= RATIO_GOAL,
+        )
+
+    return read
+
+
 def landmark_error(results: dict[str, Any]) -> Standing | None:
     """Equal or better in every group the paired interval can judge (and at least one)."""
     rows = results.get("landmark_error")
@@ -120,6 +138,16 @@ GOALS = (
         "2 threads",
         "compare_reference",
         ratio_at(2),
+    ),
+    Goal(
+        f"CPU-seconds per frame <= {RATIO_GOAL}x the reference's (issue 21), 1 thread",
+        "compare_reference",
+        cpu_ratio_at(1),
+    ),
+    Goal(
+        f"CPU-seconds per frame <= {RATIO_GOAL}x the reference's (issue 21), 2 threads",
+        "compare_reference",
+        cpu_ratio_at(2),
     ),
     Goal(
         "landmark error equal or better than the reference (paired 95 % interval)",

@@ -5,11 +5,13 @@ same frames for both sides. Errors on neighbouring frames of one walk are not in
 (the same pose, the same crop), so the resampling unit is a block of consecutive frames of
 one sequence, not a frame or a landmark: resampling landmarks would call 0.1 px
 "significant" on a 60-frame clip. The statistic is the difference of the medians over
-landmark instances, the number the error table shows.
+landmark instances, the number the error table shows, or of the means
+(`paired_mean_difference`: issue 21's bound on what an int8 model may cost).
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
@@ -63,6 +65,31 @@ def paired_median_difference(
     on both sides, so the arrays have equal length); `sequence[k]` is frame k's sequence,
     frames in time order.
     """
+    return _paired(a, b, sequence, np.median, level, resamples, seed)
+
+
+def paired_mean_difference(
+    a: list[np.ndarray],
+    b: list[np.ndarray],
+    sequence: np.ndarray,
+    *,
+    level: float = 0.95,
+    resamples: int = RESAMPLES,
+    seed: int = 0,
+) -> PairedDifference:
+    """Block-bootstrap interval of mean(a) - mean(b), pooled over landmark instances."""
+    return _paired(a, b, sequence, np.mean, level, resamples, seed)
+
+
+def _paired(
+    a: list[np.ndarray],
+    b: list[np.ndarray],
+    sequence: np.ndarray,
+    stat: Callable[[np.ndarray], float],
+    level: float,
+    resamples: int,
+    seed: int,
+) -> PairedDifference:
     if not (len(a) == len(b) == len(sequence)) or not len(a):
         raise ValueError(f"need one error array per frame on both sides: {len(a)}, {len(b)}")
     for k, (x, y) in enumerate(zip(a, b, strict=True)):
@@ -74,17 +101,19 @@ def paired_median_difference(
     for r in range(resamples):
         chosen = rng.integers(0, len(cut), size=len(cut))
         frames = np.concatenate([cut[c] for c in chosen])
-        stats[r] = _median_of(a, frames) - _median_of(b, frames)
+        stats[r] = _stat_of(a, frames, stat) - _stat_of(b, frames, stat)
     every = np.arange(len(a))
     tail = 100 * (1 - level) / 2
     return PairedDifference(
-        difference=_median_of(a, every) - _median_of(b, every),
+        difference=_stat_of(a, every, stat) - _stat_of(b, every, stat),
         low=float(np.nanpercentile(stats, tail)),
         high=float(np.nanpercentile(stats, 100 - tail)),
         level=level,
     )
 
 
-def _median_of(errors: list[np.ndarray], frames: np.ndarray) -> float:
+def _stat_of(
+    errors: list[np.ndarray], frames: np.ndarray, stat: Callable[[np.ndarray], float]
+) -> float:
     pooled = np.concatenate([errors[k] for k in frames])
-    return float(np.median(pooled)) if pooled.size else float("nan")
+    return float(stat(pooled)) if pooled.size else float("nan")

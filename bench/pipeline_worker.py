@@ -7,6 +7,7 @@ as shipped: the pruned landmark model and MediaPipe's heatmap refinement
 (monopic.pose.landmarks.refine_from_heatmap), as in the reference graph.
 
     .venv/bin/python bench/pipeline_worker.py --frames recordings/bench/frames-*.npy --threads 1
+        [--model lite|full|heavy]
 """
 
 from __future__ import annotations
@@ -35,7 +36,8 @@ class OurRunner:
 
         self._frame = Frame
         self._extractor = FeatureExtractor
-        self.pipeline = Pipeline(PipelineConfig(tracker=TrackerConfig(threads=args.threads)))
+        config = TrackerConfig(threads=args.threads, model=args.model)
+        self.pipeline = Pipeline(PipelineConfig(tracker=config))
 
     def reset(self) -> None:
         self.pipeline.tracker.reset()
@@ -60,8 +62,12 @@ class OurRunner:
         return stages, None if pose is None else pose.landmarks[:, :2]
 
 
+def options(ap: argparse.ArgumentParser) -> None:
+    ap.add_argument("--model", choices=("lite", "full", "heavy"), default="full")
+
+
 def main() -> None:
-    run(worker_args(__doc__.split("\n")[0]), OurRunner, "monopic")
+    run(worker_args(__doc__.split("\n")[0], options), OurRunner, "monopic")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,8 @@
 """The paper's reference pipeline as a benchmark worker (runs in .venv-reference).
 
 MediaPipe's Python Pose solution (mediapipe 0.10.14, mp.solutions.pose.Pose with
-static_image_mode=False, model_complexity=1: tracking mode, the full landmark model) and
+static_image_mode=False, model_complexity=1: tracking mode, the full landmark model; 0
+and 2 with --model lite / heavy, whose files bench/reference_env.py puts in place) and
 then the authors' rule cascade. The cascade, its smoothing and the warning are monopic's
 own pure-Python modules (monopic.features.orientation/.smoothing/.motion,
 monopic.predict.rules, monopic.variants.warning/.path: numpy only, they import fine
@@ -36,6 +37,7 @@ sys.path.insert(1, str(HERE.parent))  # monopic's pure-Python modules only
 from worker_common import run, worker_args  # noqa: E402
 
 MIN_FOOT_VISIBILITY = 0.5  # as monopic.features.extractor
+COMPLEXITY = {"lite": 0, "full": 1, "heavy": 2}  # MediaPipe's model_complexity
 MAX_GAP_S = 0.5
 
 
@@ -78,7 +80,9 @@ class ReferenceRunner:
         from monopic.variants.warning import CollisionWarning
 
         self.pose = mp.solutions.pose.Pose(
-            static_image_mode=False, model_complexity=1, smooth_landmarks=not args.no_smooth
+            static_image_mode=False,
+            model_complexity=COMPLEXITY[args.model],
+            smooth_landmarks=not args.no_smooth,
         )
         self._velocity_cls, self._kalman_cls = VelocityEstimator, Kalman1D
         self._facing, self._features, self._mode = facing_angle, Features, Mode.IMAGE
@@ -151,6 +155,7 @@ def options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument(
         "--no-smooth", action="store_true", help="smooth_landmarks=False (default: True)"
     )
+    ap.add_argument("--model", choices=list(COMPLEXITY), default="full")
 
 
 def main() -> None:

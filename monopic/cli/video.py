@@ -19,6 +19,7 @@ from monopic.framelog import FRAME_COLUMNS, authors_finite, frame_row
 from monopic.output import atomic_path
 from monopic.overlay import draw
 from monopic.pipeline import Pipeline, PipelineConfig, Variant
+from monopic.pose.sessions import DEFAULT_LANDMARK_MODEL, LANDMARK_MODELS
 from monopic.pose.tracker import TrackerConfig
 from monopic.predict.base import Mode
 from monopic.predict.registry import make_predictor, predictor_names
@@ -75,6 +76,13 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--threads", type=positive_int, default=1, help="onnxruntime threads (default %(default)d)"
     )
+    p.add_argument(
+        "--model",
+        choices=list(LANDMARK_MODELS),
+        default=DEFAULT_LANDMARK_MODEL,
+        help="landmark model: lite, full or heavy (MediaPipe's model_complexity 0, 1, 2; "
+        "default %(default)s)",
+    )
     g = p.add_argument_group("camera geometry (needed for ground mode and the projected zone)")
     g.add_argument("--fov", type=positive_float, help="vertical field of view, degrees")
     g.add_argument("--camera-height", type=positive_float, help="metres above the ground")
@@ -113,7 +121,9 @@ def run(args: argparse.Namespace) -> int:
             output_file(out, option)
     pipeline = Pipeline(
         PipelineConfig(
-            horizon=args.horizon, mode=mode, tracker=TrackerConfig(threads=args.threads)
+            horizon=args.horizon,
+            mode=mode,
+            tracker=TrackerConfig(threads=args.threads, model=args.model),
         ),
         predictor,
     )

@@ -98,7 +98,9 @@ def letterbox(image: np.ndarray, win: Window, size: int):
     resized = cv2.warpAffine(
         image, m_idx, (size, size), flags=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR
     )
-    tensor = resized.astype(np.float32) * (2.0 / 255.0) - 1.0
+    # In place after one scaled pass from uint8: the same values, no temporaries.
+    tensor = np.multiply(resized, np.float32(2.0 / 255.0), dtype=np.float32)
+    np.subtract(tensor, np.float32(1.0), out=tensor)
 
     def to_frame(norm: np.ndarray) -> np.ndarray:
         t = np.asarray(norm, dtype=float) * size

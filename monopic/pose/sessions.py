@@ -12,7 +12,26 @@ from pathlib import Path
 import onnxruntime as ort
 
 DETECTOR_FILE = "pose_detection.onnx"
-LANDMARK_FILE = "pose_landmark_full.onnx"
+# MediaPipe's three landmark models (its model_complexity 0, 1, 2), all converted by
+# `make models` from MediaPipe's own files (monopic/pose/models/NOTICE.md says where each
+# comes from). Full is the one the paper and MediaPipe's Pose solution use by default.
+LANDMARK_MODELS = {
+    "lite": "pose_landmark_lite.onnx",
+    "full": "pose_landmark_full.onnx",
+    "heavy": "pose_landmark_heavy.onnx",
+}
+DEFAULT_LANDMARK_MODEL = "full"
+LANDMARK_FILE = LANDMARK_MODELS[DEFAULT_LANDMARK_MODEL]
+
+
+def landmark_file(model: str) -> str:
+    """The shipped file of landmark model `model` (lite, full or heavy)."""
+    try:
+        return LANDMARK_MODELS[model]
+    except KeyError:
+        raise ValueError(
+            f"unknown landmark model {model!r}: choose one of {', '.join(LANDMARK_MODELS)}"
+        ) from None
 
 
 def model_path(name: str) -> Path:
@@ -28,12 +47,13 @@ def model_path(name: str) -> Path:
 def make_session(path: Path, threads: int = 1, spin: bool = False) -> ort.InferenceSession:
     """A CPU session using exactly `threads` intra-op threads.
 
-    `spin` lets a multi-threaded session's idle threads spin-wait between runs: for the
-    model that runs every frame on its own (the landmark model), where waking sleeping
-    threads cost 7 % and the occasional 30 % on this VM (2 threads, 7.8 vs 8.3 ms per
-    frame). Not for two sessions that take turns: each one's spinning threads then hold
-    the cores the other needs (the detector ran 2x slower right after a spinning
-    landmark session). One thread has no pool: nothing spins.
+    `spin` lets a multi-threaded session's idle threads spin-wait between runs. On a
+    quiet host that saved the landmark model 7 % at 2 threads (7.8 vs 8.3 ms per frame,
+    issue 7); on a loaded one it cost 1.6x (45 vs 27 ms, alternated, load average 11,
+    issue 21) and burns CPU time between frames, so no session spins by default. Never
+    for two sessions that take turns: each one's spinning threads then hold the cores
+    the other needs (the detector ran 2x slower right after a spinning landmark
+    session). One thread has no pool: nothing spins.
     """
     if threads < 1:
         raise ValueError(f"threads must be >= 1, got {threads}")

@@ -266,7 +266,9 @@ def test_benchmarks_md_shows_goals_latest_results_and_flags() -> None:
 
 def test_a_goal_without_a_run_says_so() -> None:
     text = render([bench_run("simulator", "2026-11-23T09:40:00Z", scenario(12.0), "T")], HISTORY)
-    assert text.count("| not measured yet | - | no `compare_reference` run |") == 3
+    compare_goals = sum(goal.benchmark == "compare_reference" for goal in GOALS)
+    assert compare_goals == 5  # 1 and 2 threads, CPU-seconds at 1 and 2, landmark error
+    assert text.count("| not measured yet | - | no `compare_reference` run |") == compare_goals
     assert "| 12.0 fps (11.5-12.5 over 4 runs) | no |" in text
     assert "No runs in `bench/history.jsonl` yet" in render([], HISTORY)
 
@@ -300,3 +302,25 @@ def test_every_goal_finds_its_figure_in_the_committed_history() -> None:
     for goal in GOALS:
         assert goal.benchmark in last, f"no {goal.benchmark} run in {HISTORY}"
         assert goal.read(last[goal.benchmark].results) is not None, goal.text
+
+
+def test_a_goal_is_judged_on_the_latest_quiet_run_not_a_loaded_one() -> None:
+    quiet_run = bench_run(
+        "compare_reference", "2026-11-23T09:30:00Z", comparison((12.0, 20.0), (9.0, 12.0), []), ""
+    )
+    loaded = replace(
+        bench_run(
+            "compare_reference",
+            "2026-11-23T10:30:00Z",
+            comparison((17.6, 422.8), (9.0, 12.0), []),
+            "",
+        ),
+        load_before=15.4,
+        load_after=13.6,
+    )
+    goals = render([quiet_run, loaded], HISTORY).split("## Ours / reference by host")[0]
+    assert "| 0.60 (12.00 vs 20.00 ms) | no |" in goals  # the quiet run judges
+    assert "0.04" not in goals  # 17.6 / 422.8 under load is not a figure to judge by
+    assert "a newer run, 2026-11-23 10:30 UTC, ran at load 15.4 before, 13.6 after" in goals
+    only_loaded = render([loaded], HISTORY).split("## Ours / reference by host")[0]
+    assert "| 0.04 (17.60 vs 422.80 ms) | not judged: load 15.4 before, 13.6 after" in only_loaded

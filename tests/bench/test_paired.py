@@ -12,7 +12,7 @@ from hypothesis import strategies as st
 from tests.paths import ROOT  # noqa: E402
 
 sys.path.insert(0, str(ROOT / "bench"))
-from paired import blocks, paired_median_difference  # noqa: E402
+from paired import blocks, paired_mean_difference, paired_median_difference  # noqa: E402
 
 
 def errors(n: int, seed: int) -> list[np.ndarray]:
@@ -61,3 +61,16 @@ def test_mismatched_frames_are_refused() -> None:
         paired_median_difference([np.ones(2)], [np.ones(3)], np.zeros(1, int))
     with pytest.raises(ValueError, match="one error array per frame"):
         paired_median_difference([np.ones(2)], [], np.zeros(1, int))
+
+
+def test_the_mean_difference_sees_a_few_large_errors_the_median_ignores() -> None:
+    """Issue 21 bounds an int8 model by the mean: a model that is off by 5 px on one frame
+    in six moves the mean by about 0.8 px while leaving the median where it was."""
+    b = errors(60, 5)
+    a = [x + (5.0 if k % 6 == 0 else 0.0) for k, x in enumerate(b)]
+    seq = np.repeat([0, 1], 30)
+    mean = paired_mean_difference(a, b, seq, resamples=500)
+    assert mean.difference == pytest.approx(5.0 / 6, abs=1e-9)
+    assert 0 < mean.low < mean.difference < mean.high
+    assert mean.verdict == "worse"
+    assert abs(paired_median_difference(a, b, seq, resamples=300).difference) < 0.5

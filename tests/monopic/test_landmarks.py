@@ -129,7 +129,7 @@ def test_landmark_model_returns_the_refined_points() -> None:
         ["landmarks", "heatmap"], {"image": (image.astype(np.float32) / 255.0)[None]}
     )
     raw = points.reshape(NUM_POINTS, 5)[:, :2].astype(np.float64)
-    refined = refine_from_heatmap(raw, heatmap[0], INPUT_SIZE)
+    refined = refine_from_heatmap(raw, heatmap[0].transpose(1, 2, 0), INPUT_SIZE)
     pose = model.run(image, region)
     got = np.vstack([pose.landmarks[:, :2], pose.aux])
     np.testing.assert_allclose(got, refined, atol=1e-3)

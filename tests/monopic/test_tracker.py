@@ -234,3 +234,32 @@ def test_the_filter_restarts_after_a_frame_where_nobody_is_found(scripted):
     got = scripted.process(IMAGE, timestamp=3 / 15).pose
     np.testing.assert_array_equal(got.landmarks, b.landmarks)
     np.testing.assert_array_equal(got.visibility, b.visibility)
+
+
+def clip_truth_first_frame() -> np.ndarray:
+    """The true pixel positions of the 33 landmarks in the clip's first frame."""
+    import csv
+
+    with CLIP.with_name("walk_clip_truth.csv").open() as fh:
+        row = next(csv.DictReader(fh))
+    return np.array([[float(row[f"lm{i}_u"]), float(row[f"lm{i}_v"])] for i in range(33)])
+
+
+@pytest.mark.parametrize("model", ["lite", "full", "heavy"])
+def test_every_landmark_model_choice_finds_the_walker(model: str):
+    """Each of MediaPipe's three landmark models loads and puts the walker's shoulders and
+    hips within a few pixels of the truth in the clip's first frame (a 768x432 frame in
+    which the walker is about 230 px tall)."""
+    tracker = PoseTracker(TrackerConfig(model=model))
+    assert tracker.landmarks.model == model
+    result = tracker.process(next(iter(VideoSource(str(CLIP)))).image)
+    assert result.found
+    assert result.pose is not None and result.pose.score > 0.5
+    torso = [11, 12, 23, 24]
+    err = np.linalg.norm(result.pose.landmarks[torso, :2] - clip_truth_first_frame()[torso], axis=1)
+    assert np.all(err < 12.0), err
+
+
+def test_an_unknown_landmark_model_is_refused_with_the_choices():
+    with pytest.raises(ValueError, match="lite, full, heavy"):
+        TrackerConfig(model="medium")

@@ -4,12 +4,16 @@ Run through ``make models`` (which provides the pinned conversion venv). Steps:
 
 1. ``pip download`` the pinned mediapipe wheel (and a matplotlib wheel, only for its
    public-domain ``grace_hopper.jpg`` sample photo) and unzip the files we need;
-   every source file is checked against a recorded sha256.
+   ``npm pack`` Google's ``@mediapipe/pose`` npm package for the lite and heavy landmark
+   models, which no mediapipe wheel ships (its full model is byte-identical to the
+   wheel's); every source file is checked against a recorded sha256.
 2. Densify the pose detector (tf2onnx cannot convert its DENSIFY ops).
-3. Convert both models with tf2onnx at a pinned opset, then give inputs/outputs
+3. Convert the models with tf2onnx at a pinned opset, then give inputs/outputs
    descriptive names, prune the landmark model to the outputs monopic reads (landmarks,
    pose flag, heatmap; onnxruntime would otherwise run the segmentation and world
-   landmark branches on every frame), store the (exactly fp16) weights as fp16, and
+   landmark branches on every frame), fold the input Pad into the first Conv and leave
+   the heatmap channels-first (one kernel less per frame, same values), store the
+   (exactly fp16) weights as fp16, and
    derive node names/order from the graph and fix all strings, so that two runs
    produce byte-identical files.
 4. Run the ORIGINAL TFLite models (sparse detector included) on a few fixed inputs
@@ -26,6 +30,7 @@ import logging
 import os
 import subprocess
 import sys
+import tarfile
 import zipfile
 from dataclasses import dataclass
 from pathlib import Path
@@ -42,7 +47,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from densify import densify  # noqa: E402
 from onnx_post import (  # noqa: E402
     canonicalize,
+    fold_pad_into_conv,
     keep_outputs,
+    output_channels_first,
     rename_values,
     stamp,
     store_fp16_weights,
@@ -69,6 +76,12 @@ MATPLOTLIB = "matplotlib==3.10.0"
 MATPLOTLIB_WHEEL_SHA256 = "5439f4c5a3e2e8eab18e2f8c3ef929772fd5641876db71f08127eed95ab64683"
 PHOTO = "matplotlib/mpl-data/sample_data/grace_hopper.jpg"
 PHOTO_SHA256 = "a8ca6d734765703b09728ab47fe59f473d93ae3967fc24c7c0288c3c7adb7130"
+# MediaPipe's JavaScript Pose solution (Google, Apache-2.0 per its package.json): the one
+# registry package found that ships pose_landmark_lite.tflite and pose_landmark_heavy.tflite
+# (the Python wheels download them at run time instead). Its full model is the wheel's.
+NPM_POSE = "@mediapipe/pose@0.5.1675469404"
+NPM_POSE_TARBALL = "mediapipe-pose-0.5.1675469404.tgz"
+NPM_POSE_SHA256 = "8bb349a7b3a3ba699df23be804ddd3b3eab810b50b15406894be257859388a84"
 SYNTHETIC_SEED = 20240508
 # Coarse sanity gate for a conversion (measured worst of the shipped outputs: 2e-4, landmarks;
 # 4e-3 for the segmentation logits, which are no longer shipped);
@@ -86,6 +99,7 @@ class ModelSpec:
     size: int
     outputs: tuple[str, ...]  # ONNX names, in the TFLite model's output order
     keep: tuple[str, ...] | None = None  # the outputs the shipped file has (None: all)
+    package: str = MEDIAPIPE  # the registry package holding `member`
 
     @property
     def shipped(self) -> tuple[str, ...]:
@@ -112,6 +126,28 @@ LANDMARK = ModelSpec(
     # monopic reads landmarks + pose flag, and the heatmap for MediaPipe's refinement step.
     keep=("landmarks", "pose_flag", "heatmap"),
 )
+LANDMARK_LITE = ModelSpec(
+    name="pose_landmark_lite",
+    member="package/pose_landmark_lite.tflite",
+    sha256="f17bfbecadb61c3be1baa8b8d851cc6619c870a87167b32848ad20db306b9d61",
+    size=256,
+    outputs=LANDMARK.outputs,
+    keep=LANDMARK.keep,
+    package=NPM_POSE,
+)
+LANDMARK_HEAVY = ModelSpec(
+    name="pose_landmark_heavy",
+    member="package/pose_landmark_heavy.tflite",
+    sha256="59e42d71bcd44cbdbabc419f0ff76686595fd265419566bd4009ef703ea8e1fe",
+    size=256,
+    outputs=LANDMARK.outputs,
+    keep=LANDMARK.keep,
+    package=NPM_POSE,
+)
+LANDMARKS = (LANDMARK_LITE, LANDMARK, LANDMARK_HEAVY)
+MODELS = (DETECTOR, *LANDMARKS)
+# The npm package's copy of the full model; must equal the wheel's (checked on every run).
+NPM_FULL_MEMBER = "package/pose_landmark_full.tflite"
 INPUT_NAME = "image"
 
 
@@ -137,6 +173,27 @@ def pip_download(spec: str, dest: Path, expected_sha256: str) -> Path:
         wheels = sorted(dest.glob(f"{name}-*.whl"))
     check(wheels[0].read_bytes(), expected_sha256, wheels[0].name)
     return wheels[0]
+
+
+def npm_pack(spec: str, tarball: str, dest: Path, expected_sha256: str) -> Path:
+    """Fetch one pinned npm package tarball with npm's own client (nothing is installed)."""
+    dest.mkdir(parents=True, exist_ok=True)
+    path = dest / tarball
+    if not path.is_file():
+        subprocess.run(["npm", "pack", spec, "--pack-destination", str(dest)], check=True)
+    check(path.read_bytes(), expected_sha256, path.name)
+    return path
+
+
+def extract_tar(tgz: Path, member: str, expected_sha256: str, dest: Path) -> Path:
+    with tarfile.open(tgz, "r:gz") as tf_:
+        handle = tf_.extractfile(member)
+        if handle is None:
+            raise SystemExit(f"{tgz.name} has no file {member}")
+        data = check(handle.read(), expected_sha256, member)
+    out = dest / Path(member).name
+    out.write_bytes(data)
+    return out
 
 
 def extract(wheel: Path, member: str, expected_sha256: str, dest: Path) -> Path:
@@ -183,14 +240,20 @@ def to_onnx(spec: ModelSpec, tflite: Path, source: Path) -> tuple[onnx.ModelProt
             f"({convs - count_ops(model, 'Conv')} of {convs} convolutions)"
         )
         print(f"{spec.name}: pruned to {', '.join(spec.keep)}: {pruned}")
+    # Layout clean-ups the landmark model's profile pointed to (bench/landmark_profile.py);
+    # both leave every output value as it was (tests/test_model_fidelity.py).
+    print(f"{spec.name}: {fold_pad_into_conv(model)} Pad(s) folded into the first Conv")
+    for name in CHANNELS_FIRST:
+        if name in spec.shipped and output_channels_first(model, name):
+            print(f"{spec.name}: `{name}` left channels-first (its Transpose dropped)")
     print(f"{spec.name}: {store_fp16_weights(model)} weight tensors stored as fp16")
     canonicalize(model)
     stamp(
         model,
-        doc=f"MediaPipe {Path(spec.member).name} from {MEDIAPIPE} (Apache-2.0); see NOTICE.md",
+        doc=f"MediaPipe {Path(spec.member).name} from {spec.package} (Apache-2.0); see NOTICE.md",
         metadata={
             "name": spec.name,
-            "source": f"{MEDIAPIPE} wheel: {spec.member}",
+            "source": f"{spec.package}: {spec.member}",
             "source_sha256": sha256(source.read_bytes()),
             "license": "Apache-2.0",
         },
@@ -240,12 +303,12 @@ def synthetic(size: int, rng: np.random.Generator) -> np.ndarray:
 
 
 def fixture_inputs(photo_jpeg: bytes) -> dict[str, np.ndarray]:
+    """The same two images for every landmark model (lite, full, heavy)."""
     photo = tf.io.decode_jpeg(photo_jpeg, channels=3).numpy()
     rng = np.random.default_rng(SYNTHETIC_SEED)
-    return {
-        DETECTOR.name: np.stack([letterbox(photo, 224), synthetic(224, rng)]),
-        LANDMARK.name: np.stack([body_crop(photo, 256), synthetic(256, rng)]),
-    }
+    detector = np.stack([letterbox(photo, 224), synthetic(224, rng)])
+    landmark = np.stack([body_crop(photo, 256), synthetic(256, rng)])
+    return {DETECTOR.name: detector} | {spec.name: landmark for spec in LANDMARKS}
 
 
 def to_float(spec: ModelSpec, images: np.ndarray) -> np.ndarray:
@@ -257,7 +320,7 @@ def to_float(spec: ModelSpec, images: np.ndarray) -> np.ndarray:
 FIXTURE_DOC = (
     "BlazePose fidelity fixture written by tools/models/convert.py. "
     "'<model>.input' is uint8 NHWC RGB; feed pose_detection as u8/127.5-1 and "
-    "pose_landmark_full as u8/255 (float32, batch of 1 per image). "
+    "pose_landmark_lite/full/heavy as u8/255 (float32, batch of 1 per image). "
     "'<model>.<output>' holds the ORIGINAL TFLite model's outputs (TF TFLite interpreter, "
     "builtin kernels, batch dim stacked over the inputs) for the outputs the shipped ONNX "
     "file keeps. Where '<model>.<output>.stride' "
@@ -267,11 +330,14 @@ FIXTURE_DOC = (
 )
 # Spatial subsampling of the big per-pixel outputs in the fixture (NHWC, H and W axes).
 FIXTURE_STRIDES = {"heatmap": 2}
+# Outputs the shipped files give channels-first (NCHW) where TFLite has NHWC; the fixture
+# keeps TFLite's layout.
+CHANNELS_FIRST = ("heatmap",)
 
 
 def build_fixture(sources: dict[str, Path], photo_jpeg: bytes) -> dict[str, np.ndarray]:
     arrays: dict[str, np.ndarray] = {"doc": np.array(FIXTURE_DOC)}
-    for spec, images in zip((DETECTOR, LANDMARK), fixture_inputs(photo_jpeg).values(), strict=True):
+    for spec, images in zip(MODELS, fixture_inputs(photo_jpeg).values(), strict=True):
         outs = [run_tflite(sources[spec.name], x) for x in to_float(spec, images)]
         arrays[f"{spec.name}.input"] = images
         for i, out_name in enumerate(spec.outputs):
@@ -313,6 +379,8 @@ def onnx_max_diffs(
         for name, got in zip(shipped, outs, strict=True):
             key = f"{spec.name}.{name}"
             ref = fixture[key][k]
+            if name in CHANNELS_FIRST:
+                got = got.transpose(0, 2, 3, 1)  # back to TFLite's NHWC
             if f"{key}.stride" in fixture:
                 stride = int(fixture[f"{key}.stride"])
                 got = got[:, ::stride, ::stride]
@@ -333,10 +401,10 @@ def apache_license(text: str) -> str:
 def write_notice(diffs: dict[str, dict[str, tuple[float, float]]], pruned: str) -> None:
     """Provenance, conventions and the measured fidelity, next to the shipped files."""
     rows = []
-    for spec in (DETECTOR, LANDMARK):
+    for spec in MODELS:
         onnx_bytes = spec.onnx_path.read_bytes()
         rows.append(
-            f"| `{spec.name}.onnx` | `{spec.member}` | `{spec.sha256}` | "
+            f"| `{spec.name}.onnx` | `{spec.package}` | `{spec.member}` | `{spec.sha256}` | "
             f"`{sha256(onnx_bytes)}` | {len(onnx_bytes):,} |"
         )
     diff_lines = [
@@ -357,6 +425,8 @@ def write_notice(diffs: dict[str, dict[str, tuple[float, float]]], pruned: str) 
         matplotlib=MATPLOTLIB,
         pruned=pruned,
         keep=", ".join(f"`{o}`" for o in LANDMARK.shipped),
+        npm=NPM_POSE,
+        npm_sha=NPM_POSE_SHA256,
     )
     (MODELS_DIR / "NOTICE.md").write_text(text)
 
@@ -370,33 +440,47 @@ MonoPIC's own code is under its own licence.
 
 ## Origin
 
-Both come from the PyPI wheel `{mediapipe}`
+The detector and the full landmark model come from the PyPI wheel `{mediapipe}`
 (`mediapipe-0.10.14-cp311-cp311-manylinux_2_17_x86_64.manylinux2014_x86_64.whl`,
-sha256 `{wheel_sha}`), unpacked, not installed.
+sha256 `{wheel_sha}`), unpacked, not installed. No mediapipe wheel ships the lite and
+heavy landmark models (MediaPipe's Python solution downloads them at run time when
+asked for `model_complexity` 0 or 2); Google's npm package `{npm}` (MediaPipe's
+JavaScript Pose solution, `license: Apache-2.0` in its package.json; tarball sha256
+`{npm_sha}`) ships all three, and its `pose_landmark_full.tflite` is byte-identical to
+the wheel's (checked on every conversion). The lite and heavy files come from there.
 
-| ONNX file | source file inside the wheel | source sha256 | ONNX sha256 | ONNX bytes |
-| --- | --- | --- | --- | --- |
+| ONNX file | registry package | source file inside it | source sha256 | ONNX sha256 | ONNX bytes |
+| --- | --- | --- | --- | --- | --- |
 {rows}
 
 ## How they are regenerated
 
 `make models` (see `Makefile.models`) creates `.venv-models` from
 `tools/models/requirements.txt` and runs `tools/models/convert.py`, which downloads
-the wheel, checks the sha256 values above, and:
+the wheel (pip) and the npm package (`npm pack`, so npm must be on PATH), checks the
+sha256 values above, and:
 
 - densifies the detector: its 38 sparse fp16 weight tensors sit behind DENSIFY ops,
   which tf2onnx cannot convert; the converter evaluates them once with TFLite's
   reference kernels and stores the dense result as constants (no values change);
-- converts both models with tf2onnx {tf2onnx} (tensorflow-cpu {tf}, onnx {onnx}) at
+- converts the models with tf2onnx {tf2onnx} (tensorflow-cpu {tf}, onnx {onnx}) at
   opset {opset}, renames inputs/outputs (below), stores the weights, which are fp16
   in the sources, as fp16 initializers + Cast (lossless), and names nodes from the
   graph structure;
-- prunes the landmark model to the outputs monopic reads. onnxruntime runs every
+- prunes the landmark models to the outputs monopic reads. onnxruntime runs every
   node of a graph whatever outputs are requested, so unused branches would cost time
   on every frame. The pruning (`keep_outputs` in `tools/models/onnx_post.py`, which
   keeps the same nodes as `onnx.utils.extract_model`) only removes nodes, so the kept
-  outputs are computed exactly as in the full conversion. It keeps {keep} and
-  {pruned};
+  outputs are computed exactly as in the full conversion. It keeps {keep}; for the
+  full model it {pruned};
+- folds the zero Pad that tf2onnx writes before the first, strided convolution (Pad ->
+  Transpose -> Conv, which onnxruntime cannot fuse across the Transpose) into that
+  Conv's padding: the profile in `bench/landmark_profile.py` showed it as a kernel of
+  its own on every frame (1 % of the landmark model's kernel time); and drops the
+  Transpose that turned the landmark models' heatmap back to NHWC (`heatmap` is
+  channels-first; where onnxruntime uses its NCHWc layout it folds that Transpose into
+  a layout reorder anyway, so this saves no measurable time there); the outputs keep
+  their values;
 - writes `tests/data/pose_reference.npz` with the ORIGINAL TFLite models' outputs on
   fixed inputs (the outputs the ONNX files keep), checked by
   `tests/test_model_fidelity.py`. One input is the public domain Grace Hopper
@@ -406,7 +490,7 @@ With the pinned environment the outputs are byte-identical from run to run.
 
 ## Inputs and outputs
 
-Both models take one float32 NHWC RGB image, batch 1, named `image`.
+Every model takes one float32 NHWC RGB image, batch 1, named `image`.
 
 ### `pose_detection.onnx`
 
@@ -422,11 +506,13 @@ Both models take one float32 NHWC RGB image, batch 1, named `image`.
   1, strides 8, 16, 32 with 2, 2, 6 anchors per cell (28x28x2 + 14x14x2 + 7x7x6 = 2254).
 - `scores` [1, 2254, 1]: logits; apply a sigmoid (MediaPipe clips to +-100 first).
 
-### `pose_landmark_full.onnx`
+### `pose_landmark_full.onnx` (and `pose_landmark_lite.onnx`, `pose_landmark_heavy.onnx`)
 
-Pruned: the TFLite model also outputs a segmentation mask ([1, 256, 256, 1] logits) and
-world landmarks ([1, 117], 39 x (x, y, z) in metres, origin at the hip centre); this
-file has only the three outputs below.
+The lite and heavy models have the same inputs and outputs as the full one (smaller and
+larger networks, MediaPipe's `model_complexity` 0 and 2). Pruned: the TFLite models
+also output a segmentation mask ([1, 256, 256, 1] logits) and world landmarks ([1, 117],
+39 x (x, y, z) in metres, origin at the hip centre); these files have only the three
+outputs below.
 
 - `image` [1, 256, 256, 3]: RGB scaled to [0, 1] (`u8 / 255`), the ROI crop.
 - `landmarks` [1, 195]: 39 x (x, y, z, visibility, presence). x, y in crop pixels
@@ -436,7 +522,9 @@ file has only the three outputs below.
   keypoints 0 and 1); 35-38 are unused by MediaPipe.
 - `pose_flag` [1, 1]: probability that a pose is present (the graph ends in a
   Sigmoid; MediaPipe's threshold is 0.5).
-- `heatmap` [1, 64, 64, 39]: per-landmark heatmap logits, used by MediaPipe's
+- `heatmap` [1, 39, 64, 64]: per-landmark heatmap logits, channels first (TFLite's
+  output is [1, 64, 64, 39]; the converter drops the Transpose to it, a kernel of its
+  own on every frame), used by MediaPipe's
   heatmap refinement step (which applies a sigmoid; monopic does the same step in
   `monopic/pose/landmarks.py`).
 
@@ -467,15 +555,24 @@ def main(argv: list[str] | None = None) -> int:
         photo = check(zf.read(PHOTO), PHOTO_SHA256, PHOTO)
     with zipfile.ZipFile(wheel) as zf:
         license_text = check(zf.read(MEDIAPIPE_LICENSE), MEDIAPIPE_LICENSE_SHA256, "LICENSE")
-    sources = {s.name: extract(wheel, s.member, s.sha256, work) for s in (DETECTOR, LANDMARK)}
+    npm_tgz = npm_pack(NPM_POSE, NPM_POSE_TARBALL, work / "npm", NPM_POSE_SHA256)
+    extract_tar(npm_tgz, NPM_FULL_MEMBER, LANDMARK.sha256, work / "npm")  # the wheel's file
+    sources = {
+        s.name: (
+            extract(wheel, s.member, s.sha256, work)
+            if s.package == MEDIAPIPE
+            else extract_tar(npm_tgz, s.member, s.sha256, work)
+        )
+        for s in MODELS
+    }
 
     dense = work / "pose_detection_dense.tflite"
     print(f"densified {densify(sources[DETECTOR.name], dense)} DENSIFY ops")
-    convert_from = {DETECTOR.name: dense, LANDMARK.name: sources[LANDMARK.name]}
+    convert_from = {s.name: sources[s.name] for s in LANDMARKS} | {DETECTOR.name: dense}
 
     MODELS_DIR.mkdir(parents=True, exist_ok=True)
     pruned: dict[str, str | None] = {}
-    for spec in (DETECTOR, LANDMARK):
+    for spec in MODELS:
         model, pruned[spec.name] = to_onnx(spec, convert_from[spec.name], sources[spec.name])
         spec.onnx_path.write_bytes(model.SerializeToString(deterministic=True))
         print(f"wrote {spec.onnx_path.relative_to(REPO)}")
@@ -486,7 +583,7 @@ def main(argv: list[str] | None = None) -> int:
     save_npz(FIXTURE, fixture)
     print(f"wrote {FIXTURE.relative_to(REPO)} ({FIXTURE.stat().st_size:,} bytes)")
 
-    diffs = {spec.name: onnx_max_diffs(spec, fixture) for spec in (DETECTOR, LANDMARK)}
+    diffs = {spec.name: onnx_max_diffs(spec, fixture) for spec in MODELS}
     for name, d in diffs.items():
         print(name, {k: f"{a:.3g} (rel {r:.3g})" for k, (a, r) in d.items()})
     worst = max(rel for d in diffs.values() for _, rel in d.values())

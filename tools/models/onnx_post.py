@@ -155,3 +155,99 @@ def keep_outputs(model: onnx.ModelProto, names: Sequence[str]) -> int:
         del field[:]
         field.extend(values)
     return removed
+
+
+def fold_pad_into_conv(model: onnx.ModelProto) -> int:
+    """Move zero Pads that reach a Conv through a layout Transpose into the Conv's pads.
+
+    tf2onnx writes TFLite's explicit SAME padding of the first, strided convolution as
+    Pad (NHWC) -> Transpose (to NCHW) -> Conv. onnxruntime fuses a Pad into the Conv that
+    reads it directly, but not across the Transpose, so the first Pad ran as its own
+    kernel over the whole 256x256x3 input on every frame (1.3 % of the landmark model's
+    kernel time on a loaded host, bench/landmark_profile.py). Rewired as Transpose ->
+    Conv with the pad amounts in the Conv's `pads` (permuted to NCHW), the outputs are
+    the same. Returns the number of Pads folded.
+    """
+    graph = model.graph
+    inits = {i.name: i for i in graph.initializer}
+    users: dict[str, list[onnx.NodeProto]] = {}
+    for node in graph.node:
+        for name in node.input:
+            users.setdefault(name, []).append(node)
+    folded: list[onnx.NodeProto] = []
+    for pad in [n for n in graph.node if n.op_type == "Pad"]:
+        mode = next((a.s for a in pad.attribute if a.name == "mode"), b"constant")
+        if mode != b"constant" or len(pad.input) < 2 or pad.input[1] not in inits:
+            continue
+        if (
+            len(pad.input) > 2
+            and pad.input[2]
+            and (pad.input[2] not in inits or numpy_helper.to_array(inits[pad.input[2]]).any())
+        ):
+            continue
+        nexts = users.get(pad.output[0], [])
+        if len(nexts) != 1 or nexts[0].op_type != "Transpose":
+            continue
+        transpose = nexts[0]
+        perm = list(next(a.ints for a in transpose.attribute if a.name == "perm"))
+        convs = users.get(transpose.output[0], [])
+        if (
+            len(convs) != 1
+            or convs[0].op_type != "Conv"
+            or convs[0].input[0] != transpose.output[0]
+        ):
+            continue
+        conv = convs[0]
+        amounts = numpy_helper.to_array(inits[pad.input[1]]).astype(int)
+        rank = len(perm)
+        begin, end = amounts[:rank][perm], amounts[rank:][perm]  # in the Conv's axis order
+        if begin[:2].any() or end[:2].any():
+            continue  # padding batch or channels is not a Conv padding
+        if any(a.name == "auto_pad" and a.s not in (b"", b"NOTSET") for a in conv.attribute):
+            continue
+        old = next((list(a.ints) for a in conv.attribute if a.name == "pads"), [0] * 2 * (rank - 2))
+        spatial = rank - 2
+        new = [int(old[i] + begin[2 + i]) for i in range(spatial)]
+        new += [int(old[spatial + i] + end[2 + i]) for i in range(spatial)]
+        kept = [a for a in conv.attribute if a.name != "pads"]
+        del conv.attribute[:]
+        conv.attribute.extend([*kept, helper.make_attribute("pads", new)])
+        transpose.input[0] = pad.input[0]
+        folded.append(pad)
+    for pad in folded:
+        graph.node.remove(pad)
+    used = {name for node in graph.node for name in node.input}
+    kept_inits = [i for i in graph.initializer if i.name in used]
+    del graph.initializer[:]
+    graph.initializer.extend(kept_inits)
+    return len(folded)
+
+
+def output_channels_first(model: onnx.ModelProto, name: str) -> bool:
+    """Drop the final NCHW -> NHWC Transpose in front of output `name` (True if dropped).
+
+    The landmark model's heatmap leaves its last Conv as NCHW and tf2onnx transposes it
+    back to TFLite's NHWC. monopic reads 7x7 windows of it, in any layout, so the output
+    can stay NCHW. (With its NCHWc layout onnxruntime already folds this Transpose into
+    the last layout reorder, so on such CPUs the saving is not measurable; the graph is
+    one node simpler wherever that transformer does not run.)
+    """
+    graph = model.graph
+    node = next((n for n in graph.node if name in n.output), None)
+    if node is None or node.op_type != "Transpose":
+        return False
+    if list(next(a.ints for a in node.attribute if a.name == "perm")) != [0, 2, 3, 1]:
+        return False
+    source = node.input[0]
+    for other in graph.node:
+        if other is not node:
+            other.input[:] = [name if n == source else n for n in other.input]
+            other.output[:] = [name if n == source else n for n in other.output]
+    graph.node.remove(node)
+    out = next(o for o in graph.output if o.name == name)
+    dims = out.type.tensor_type.shape.dim
+    values = [d.dim_value for d in dims]
+    n, h, w, c = values
+    for d, v in zip(dims, (n, c, h, w), strict=True):
+        d.dim_value = v
+    return True
