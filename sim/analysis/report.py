@@ -8,6 +8,7 @@ never holds a half-written report.
 from __future__ import annotations
 
 import math
+from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -212,6 +213,21 @@ def goal_lines(m: SweepMetrics) -> list[str]:
     return out
 
 
+def runs(n: int) -> str:
+    return f"{n} run" if n == 1 else f"{n} runs"
+
+
+def sweeps_line(rows: Sequence[RunResult]) -> str:
+    """Which sweep(s) the file's runs came from: a file written by two sweeps is named as
+    such, so the counts below are not mistaken for one sweep's."""
+    count = Counter(r.sweep or "unnamed" for r in rows)
+    if len(count) == 1:
+        ((name, n),) = count.items()
+        return f"Sweep: `{name}`, {runs(n)}."
+    names = ", ".join(f"`{name}` ({runs(n)})" for name, n in count.most_common())
+    return f"Runs of {len(count)} sweeps, counted together below: {names}."
+
+
 def write_report(
     m: SweepMetrics, rows: Sequence[RunResult], results: Path, out_dir: Path
 ) -> Report:
@@ -224,6 +240,8 @@ def write_report(
         f"# Sweep report: {results.name}",
         "",
         f"Ran on: {footer}. Results: `{results}`.",
+        "",
+        sweeps_line(rows),
         "",
         "Collision warning per run and per frame. Recall counts collision runs warned before",
         f"contact (95 % Wilson lower bound in brackets); recall@{LEAD_GOAL:g}s only warnings at",

@@ -29,7 +29,7 @@ def run(args: argparse.Namespace) -> int:
     from monopic.cli.args import output_folder
     from monopic.errors import UserError
     from sim.analysis.metrics import compute
-    from sim.analysis.report import ran_on, write_report
+    from sim.analysis.report import ran_on, sweeps_line, write_report
     from sim.runs.results_file import read_results
 
     results: Path = args.results
@@ -44,6 +44,7 @@ def run(args: argparse.Namespace) -> int:
     report = write_report(metrics, rows, results, out)
     print(report.headline)
     print(f"\n{ran_on(metrics)}")
+    print(sweeps_line(rows).replace("`", ""))
     print(f"report: {report.markdown} ({len(report.plots)} plots)")
     return 0
 

@@ -37,6 +37,12 @@ class ResultsState:
     codes: Counter[str] = field(default_factory=Counter)  # lines per code version
     # The first line (1-based) holding each result schema (sim.runs.runner.SCHEMA).
     schemas: dict[int, int] = field(default_factory=dict)
+    sweeps: Counter[str] = field(default_factory=Counter)  # lines per sweep name
+
+    def other_sweeps(self, name: str) -> Counter[str]:
+        """Lines written by sweeps other than `name` (a results file holds one sweep: two
+        sharing a file would be counted as one by the report, naming neither)."""
+        return Counter({n: k for n, k in self.sweeps.items() if n not in (name, UNKNOWN)})
 
     def other_code(self, code: str) -> Counter[str]:
         """Lines made by code other than `code`, per code version."""
@@ -62,6 +68,7 @@ def scan(path: Path) -> ResultsState:
     ids: set[str] = set()
     codes: Counter[str] = Counter()
     schemas: dict[int, int] = {}
+    sweeps: Counter[str] = Counter()
     good = 0
     *complete, tail = path.read_bytes().split(b"\n")
     for number, raw in enumerate(complete, start=1):
@@ -76,12 +83,13 @@ def scan(path: Path) -> ResultsState:
             ) from None
         ids.add(run_id)
         codes[str(row.get("code") or UNKNOWN)] += 1
+        sweeps[str(row.get("sweep") or UNKNOWN)] += 1
         schema = row.get("schema")
         if isinstance(schema, int) and not isinstance(schema, bool):
             schemas.setdefault(schema, number)
         good += len(raw) + 1
     # Lines are written whole, newline included: an unterminated tail is a torn write.
-    return ResultsState(frozenset(ids), good, bool(tail), codes, schemas)
+    return ResultsState(frozenset(ids), good, bool(tail), codes, schemas, sweeps)
 
 
 def read_rows(path: Path) -> Iterator[dict[str, Any]]:

@@ -276,6 +276,14 @@ def run_sweep(
             "(written by newer code, which alone reads it); to redo its runs with this code, "
             "use another --out, or --restart to set the file aside and start over"
         )
+    mixed = state.other_sweeps(spec.name) if state else None
+    if mixed and not restart:
+        names = ", ".join(f"{n!r} ({k} run{'' if k == 1 else 's'})" for n, k in mixed.most_common())
+        raise UserError(
+            f"{out}: holds runs of another sweep ({names}), not of {spec.name!r}; a results "
+            "file holds one sweep, so give this one another --out (or --restart to set that "
+            "file aside and start over)"
+        )
     if other and not restart:
         versions = ", ".join(f"{n} by {c}" for c, n in other.most_common())
         raise UserError(
@@ -283,7 +291,9 @@ def run_sweep(
             "sweep resumes only its own code's runs; use another --out, or --restart to "
             "set the old results aside and start over"
         )
-    if other or newer:
+    if mixed:
+        set_aside(out, folder, mixed.most_common(1)[0][0])
+    elif other or newer:
         tag = other.most_common(1)[0][0] if other and len(other) == 1 else "mixed"
         set_aside(out, folder, tag if other else f"schema{newer[1]}")
     with ResultsWriter(out) as writer:

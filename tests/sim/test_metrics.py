@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
@@ -18,7 +19,7 @@ from sim.analysis.metrics import (
     summarise,
     wilson,
 )
-from sim.analysis.report import write_report
+from sim.analysis.report import sweeps_line, write_report
 from sim.runs.result import RunResult
 
 DT = 0.1
@@ -224,6 +225,12 @@ def test_compute_groups_and_report_files(tmp_path: Path) -> None:
     pngs = sorted(p.name for p in (tmp_path / "rep").glob("*.png"))
     assert sorted(p.name for p in report.plots) == pngs and len(pngs) == 7
     assert "rules/image" in report.headline
+    # One sweep is named; runs of two sweeps in one file are said to be counted together.
+    assert "Sweep: `unnamed`, 5 runs." in report.markdown.read_text()
+    mixed = [replace(rows[0], sweep="demo"), replace(rows[1], sweep="demo"), rows[2]]
+    assert sweeps_line(mixed) == (
+        "Runs of 2 sweeps, counted together below: `demo` (2 runs), `unnamed` (1 run)."
+    )
 
 
 def test_nuisance_warnings_and_flicker_count_episodes_off_any_collision_course():

@@ -191,6 +191,25 @@ def test_results_of_other_code_are_not_resumed_but_set_aside_on_request(
         run_sweep(spec, out, local_executor(1), progress=False, restart=True)
 
 
+def test_a_results_file_of_another_sweep_is_refused_naming_it(
+    spec_path: Path, tmp_path: Path
+) -> None:
+    spec = load_spec(spec_path)
+    out = tmp_path / "results.jsonl"
+    ids = [r.id for r in expand_spec(spec)]
+    other = {"id": ids[0], "code": code_version(), "sweep": "demo"}
+    out.write_text(json.dumps(other) + "\n")
+    with pytest.raises(
+        UserError, match=rf"another sweep \('demo' \(1 run\)\), not of '{spec.name}'"
+    ):
+        run_sweep(spec, out, local_executor(1), progress=False)
+    assert out.read_text().count("\n") == 1  # untouched
+    # Lines without a sweep name (older files) do not count as another sweep.
+    assert scan(out).other_sweeps("demo") == {}
+    out.write_text(json.dumps({"id": ids[0], "code": code_version()}) + "\n")
+    assert scan(out).other_sweeps(spec.name) == {}
+
+
 def _children(pid: int) -> set[int]:
     path = Path(f"/proc/{pid}/task/{pid}/children")
     return {int(x) for x in path.read_text().split()} if path.exists() else set()
