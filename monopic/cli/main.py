@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import os
 import signal
 import sys
 import threading
@@ -74,7 +75,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run one sub-command; every way it ends is one line and an exit code.
 
     0 done, 1 the command's own failure (e.g. failed runs), 2 bad input (UserError),
-    130 interrupted (SIGINT, Ctrl-C), 143 terminated (SIGTERM). The SIGTERM handler goes
+    130 interrupted (SIGINT, Ctrl-C), 143 terminated (SIGTERM), 141 the output's reader
+    went away (a closed pipe). The SIGTERM handler goes
     in first, so a stop while the commands load is answered like one mid-run.
     """
     in_main_thread = threading.current_thread() is threading.main_thread()
@@ -99,6 +101,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     except Terminated:
         print(f"{command}: terminated", file=sys.stderr)
         return 143
+    except BrokenPipeError:
+        # The reader went away (`monopic ... | head`): stop quietly, as other tools do.
+        # Python would flush stdout again at exit and print a traceback for that too.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 141
     finally:
         if in_main_thread:
             signal.signal(signal.SIGTERM, previous)

@@ -300,3 +300,29 @@ def test_closed_loop_and_dataset_make_their_output_folders(
     assert (out / "README.md").is_file() and (out / "runs").is_dir()
     printed = capsys.readouterr().out
     assert "time: about 3 s on 1 worker: 3 s to start, then up to 6 frames x " in printed
+
+
+def test_output_piped_into_a_reader_that_stops_early_ends_quietly() -> None:
+    # `monopic sweep large.toml --dry-run | head -1`: the reader closes the pipe after a
+    # few bytes; the command stops with 141 and no traceback (Python's would be two).
+    import subprocess
+    import sys
+
+    proc = subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "monopic",
+            "sweep",
+            str(SCENARIOS / "sweeps/large.toml"),
+            "--dry-run",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+    )
+    assert proc.stdout is not None and proc.stderr is not None
+    proc.stdout.read(10)
+    proc.stdout.close()
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=60) == 141
+    assert "Traceback" not in err and "BrokenPipeError" not in err
