@@ -47,11 +47,26 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--no-near-misses", action="store_true", help="skip the near misses")
     p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
-    p.add_argument("--executor", choices=("local", "ray"), default="local")
+    p.add_argument(
+        "--executor",
+        choices=("local", "ray"),
+        default="local",
+        help="local worker processes or a Ray cluster (default %(default)s)",
+    )
     p.add_argument("--address", help="Ray cluster address (--executor ray)")
     p.add_argument("--restart", action="store_true", help="set aside other code's results")
-    p.add_argument("--protocol", type=Path, default=PROTOCOL, help=argparse.SUPPRESS)
-    p.add_argument("--car", type=Path, default=CAR, help=argparse.SUPPRESS)
+    p.add_argument(
+        "--protocol",
+        type=Path,
+        default=PROTOCOL,
+        help="the protocol's grid, speeds and tolerances (default %(default)s)",
+    )
+    p.add_argument(
+        "--car",
+        type=Path,
+        default=CAR,
+        help="the car under test: brake, pitch, policies (default %(default)s)",
+    )
     p.set_defaults(func=run)
 
 
