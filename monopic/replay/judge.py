@@ -23,6 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from monopic.cases import Case
+from monopic.predict.base import Predictor
 from monopic.predict.constant_velocity import ConstantVelocityPredictor
 from monopic.replay.dataset import PreparedLog
 from monopic.replay.metrics import horizon_errors
@@ -65,7 +66,7 @@ def leave_one_out(n: int) -> list[tuple[int, tuple[int, ...]]]:
     return [(k, tuple(j for j in range(n) if j != k)) for k in range(n)]
 
 
-def predict_centres(predictor: TreePredictor | ConstantVelocityPredictor, log: PreparedLog):
+def predict_centres(predictor: Predictor, log: PreparedLog) -> tuple[np.ndarray, tuple[Case, ...]]:
     """(n, 2) predicted centres and the cases, one per row of `log`, at its horizon."""
     preds = [predictor.predict(f, log.horizon) for f in log.features]
     return np.array([p.center for p in preds], dtype=float), tuple(p.case for p in preds)
