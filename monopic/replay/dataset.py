@@ -1,10 +1,12 @@
 """From an authors' log to per-row features, labels and targets.
 
-Per row: our own velocity (VelocityEstimator on the raw centre and time columns, never
-their smoothed speed columns), phi from their angleOfApproach column (their logs lack the
-z needed to recompute it), the foot point centreY + height/2 and the apparent height
-occupiedHeights * 432. The label of row i is the case of the next `horizon` seconds of
-motion, from the static-camera image labelling (`case_from_image_track`) of the track over
+Per row: our own velocity from the raw centre and time columns, never their smoothed
+speed columns (VelocityEstimator by default; with `velocity_window` the least-squares
+slope over the trailing window of that many seconds, which the horizon judge uses),
+phi from their angleOfApproach column (their logs lack the z needed to recompute it),
+the foot point centreY + height/2 and the apparent height occupiedHeights * 432. The
+label of row i is the case of the next `horizon` seconds of motion, from the
+static-camera image labelling (`case_from_image_track`) of the track over
 [t_i, t_i + horizon], its end interpolated from the log's own timestamps; the target is
 the centre's displacement over the same interval. Rows whose t_i + horizon lies beyond the
 log's last timestamp have neither. Rows less than `warm_up` seconds after the first one
@@ -39,6 +41,7 @@ class PreparedLog:
     features: tuple[Features, ...]
     labels: tuple[Case | None, ...]
     future_center: np.ndarray  # (n, 2) centre at t + horizon, NaN where unknown
+    velocity_window: float | None = None  # seconds; None: VelocityEstimator's 4 frames
 
     @property
     def warm(self) -> np.ndarray:
@@ -65,8 +68,26 @@ class PreparedLog:
                 continue
             h = f.apparent_height
             d = self.future_center[i] - np.asarray(f.center)
-            out.append(TrainingSample(values, label, (float(d[0] / h), float(d[1] / h))))
+            k = self.horizon / h
+            out.append(
+                TrainingSample(
+                    values,
+                    label,
+                    (float(d[0] / h), float(d[1] / h)),
+                    velocity_displacement=(f.vx * k, f.vy * k),
+                )
+            )
         return out
+
+    @property
+    def velocity_note(self) -> str:
+        """How the rows' vx, vy were measured (for a model's provenance)."""
+        if self.velocity_window is None:
+            return "monopic.features.motion.VelocityEstimator(window=4, average=4)"
+        return (
+            "least-squares slope of the centre over the trailing "
+            f"{self.velocity_window:g} s (monopic.replay.dataset.window_velocities)"
+        )
 
 
 def recompute_velocities(log: AuthorsLog) -> np.ndarray:
@@ -80,14 +101,41 @@ def recompute_velocities(log: AuthorsLog) -> np.ndarray:
     )
 
 
-def prepare(log: AuthorsLog, horizon: float = HORIZON_S, warm_up: float = WARM_UP_S) -> PreparedLog:
+def window_velocities(log: AuthorsLog, window: float) -> np.ndarray:
+    """(n, 2) centre velocity in px/s: least-squares slope over the rows in [t - window, t].
+
+    The row before is always included, so a gap in the log longer than the window still
+    gives a two-point velocity; the first row has none (NaN).
+    """
+    if not window > 0:
+        raise ValueError(f"velocity window must be positive, got {window}")
+    t, x, y = log.time, log.center_x, log.center_y
+    out = np.full((len(log), 2), np.nan)
+    for i in range(1, len(log)):
+        lo = min(int(np.searchsorted(t, t[i] - window, side="left")), i - 1)
+        ts = t[lo : i + 1] - t[lo : i + 1].mean()
+        denom = float(np.dot(ts, ts))
+        out[i, 0] = np.dot(ts, x[lo : i + 1] - x[lo : i + 1].mean()) / denom
+        out[i, 1] = np.dot(ts, y[lo : i + 1] - y[lo : i + 1].mean()) / denom
+    return out
+
+
+def prepare(
+    log: AuthorsLog,
+    horizon: float = HORIZON_S,
+    warm_up: float = WARM_UP_S,
+    velocity_window: float | None = None,
+) -> PreparedLog:
     """Features, next-horizon labels and future centres for every row of `log`."""
     if not horizon > 0:
         raise ValueError(f"horizon must be positive, got {horizon}")
     t = log.time
     h = log.apparent_height
     foot_v = log.center_y + h / 2
-    vel = recompute_velocities(log)
+    if velocity_window is None:
+        vel = recompute_velocities(log)
+    else:
+        vel = window_velocities(log, velocity_window)
     features = tuple(
         Features(
             timestamp=float(t[i]),
@@ -112,4 +160,4 @@ def prepare(log: AuthorsLog, horizon: float = HORIZON_S, warm_up: float = WARM_U
         u = np.interp(ts, t, log.center_x)
         labels.append(case_from_image_track(ts, u, np.interp(ts, t, foot_v), np.interp(ts, t, h)))
         future[i] = (u[-1], np.interp(t_end, t, log.center_y))
-    return PreparedLog(log, horizon, warm_up, features, tuple(labels), future)
+    return PreparedLog(log, horizon, warm_up, features, tuple(labels), future, velocity_window)

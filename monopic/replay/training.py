@@ -11,9 +11,10 @@ from monopic.predict.base import Mode
 from monopic.replay.dataset import PreparedLog
 from monopic.tree.discretise import AUTHORS_DEAD_ZONE, authors_discretiser
 from monopic.tree.id3 import ID3Params
-from monopic.tree.model import TreeModel, fit_model
+from monopic.tree.model import LeafValue, TreeModel, fit_model
 
 DISCRETISERS = ("authors", "entropy")
+LEAF_VALUES = tuple(v.value for v in LeafValue)
 # A node with fewer training rows than this is not split: with a few hundred rows, leaves
 # of one or two rows would hand their single displacement to every future match.
 DEFAULT_MIN_SAMPLES = 10
@@ -27,21 +28,31 @@ class TrainOptions:
     dead_zone: float = AUTHORS_DEAD_ZONE
     min_samples: int = DEFAULT_MIN_SAMPLES
     max_depth: int | None = None
+    leaf_value: str = LeafValue.DISPLACEMENT.value
+    shrink: float = 0.0  # rows: velocity gains pulled toward 1 by n / (n + shrink)
 
     def __post_init__(self) -> None:
         if self.discretiser not in DISCRETISERS:
             raise ValueError(f"discretiser must be one of {DISCRETISERS}, got {self.discretiser!r}")
         if not self.dead_zone >= 0:
             raise ValueError(f"dead zone must be >= 0, got {self.dead_zone}")
+        if self.leaf_value not in LEAF_VALUES:
+            raise ValueError(f"leaf value must be one of {LEAF_VALUES}, got {self.leaf_value!r}")
+        if not self.shrink >= 0:
+            raise ValueError(f"shrink must be >= 0, got {self.shrink}")
         ID3Params(self.min_samples, self.max_depth)  # validates both
 
     def to_json(self) -> dict[str, Any]:
-        return {
+        out: dict[str, Any] = {
             "discretiser": self.discretiser,
             "dead_zone": self.dead_zone if self.discretiser == "authors" else None,
             "min_samples": self.min_samples,
             "max_depth": self.max_depth,
         }
+        if self.leaf_value != LeafValue.DISPLACEMENT.value:  # older files lack these keys
+            out["leaf_value"] = self.leaf_value
+            out["shrink"] = self.shrink
+        return out
 
 
 def train_on_logs(logs: Sequence[PreparedLog], options: TrainOptions) -> TreeModel:
@@ -51,6 +62,8 @@ def train_on_logs(logs: Sequence[PreparedLog], options: TrainOptions) -> TreeMod
     horizons = {p.horizon for p in logs}
     if len(horizons) != 1:
         raise ValueError(f"logs prepared with different horizons: {sorted(horizons)}")
+    if len({p.velocity_note for p in logs}) != 1:
+        raise ValueError("logs prepared with different velocity estimates")
     samples = []
     files = []
     for p in logs:
@@ -77,7 +90,7 @@ def train_on_logs(logs: Sequence[PreparedLog], options: TrainOptions) -> TreeMod
             "monopic.cases.case_from_image_track over [t, t + horizon], "
             f"thresholds lateral {th.lateral} and depth {th.depth} heights/s"
         ),
-        "velocity": "monopic.features.motion.VelocityEstimator(window=4, average=4)",
+        "velocity": logs[0].velocity_note,
     }
     disc = authors_discretiser(options.dead_zone) if options.discretiser == "authors" else "entropy"
     return fit_model(
@@ -87,6 +100,8 @@ def train_on_logs(logs: Sequence[PreparedLog], options: TrainOptions) -> TreeMod
         params=ID3Params(options.min_samples, options.max_depth),
         horizon=next(iter(horizons)),
         provenance=provenance,
+        leaf_value=LeafValue(options.leaf_value),
+        shrink=options.shrink,
     )
 
 

@@ -1,11 +1,20 @@
 """The trained tree as a predictor: bins -> ID3 node -> case and where the person will be.
 
-A leaf stores the case of its training rows and their mean displacement over the
-training horizon. In image mode the displacement is in units of the pedestrian's apparent
-height (so one tree serves people near and far): future = current + mean * height. In
-ground mode it is in metres on the ground, in the robot's frame. `Placement.CASE` instead
-extrapolates the measured velocity along the tree's case (`extrapolate_image`), the
-paper's method, so the two can be compared.
+A leaf stores the case of its training rows and, by the model's `leaf_value`, either
+their mean displacement over the training horizon or a velocity gain per image axis.
+
+- displacement: in image mode in units of the pedestrian's apparent height (so one tree
+  serves people near and far): future = current + mean * height; in ground mode metres
+  on the ground, in the robot's frame. It throws the measured speed away (a leaf holds
+  the average of everyone whose velocity fell in its bins).
+- velocity-gain (image mode): future = current + (gx * vx, gy * vy) * horizon, the gains
+  learnt per leaf as the weighted median of actual over constant-velocity displacement
+  (the gain minimising the absolute error, robust to tracker jumps), shrunk toward 1
+  (constant velocity) by n / (n + shrink). The tree corrects constant velocity where its
+  training rows say so and keeps the measured speed.
+
+`Placement.CASE` instead extrapolates the measured velocity along the tree's case
+(`extrapolate_image`), the paper's method, so they can be compared.
 """
 
 from __future__ import annotations
@@ -40,6 +49,13 @@ from monopic.tree.ops import Ops
 DISPLACEMENT_UNITS = {Mode.IMAGE: "apparent-height", Mode.GROUND: "metre"}
 
 
+class LeafValue(StrEnum):
+    """What a leaf's two numbers mean: a displacement, or a gain on the measured velocity."""
+
+    DISPLACEMENT = "displacement"
+    VELOCITY_GAIN = "velocity-gain"
+
+
 class Placement(StrEnum):
     """Where a tree prediction puts the person: the leaf's learned mean displacement, or
     the measured velocity extrapolated along the leaf's case."""
@@ -59,6 +75,8 @@ class TrainingSample:
     values: Mapping[str, float]
     label: Case
     displacement: tuple[float, float]
+    # What constant velocity moves over the same horizon, same unit (velocity-gain leaves).
+    velocity_displacement: tuple[float, float] | None = None
 
 
 @dataclass(frozen=True)
@@ -72,6 +90,11 @@ class TreeModel:
     root_entropy: float
     root_gains: tuple[tuple[str, float], ...]
     provenance: Mapping[str, Any] = field(default_factory=dict)
+    leaf_value: LeafValue = LeafValue.DISPLACEMENT
+
+    def __post_init__(self) -> None:
+        if self.leaf_value is LeafValue.VELOCITY_GAIN and self.mode is not Mode.IMAGE:
+            raise ValueError("velocity-gain leaves are for image mode only")
 
     @property
     def displacement_unit(self) -> str:
@@ -95,12 +118,23 @@ def fit_model(
     params: ID3Params | None = None,
     horizon: float = 1.0,
     provenance: Mapping[str, Any] | None = None,
+    leaf_value: LeafValue = LeafValue.DISPLACEMENT,
+    shrink: float = 0.0,
 ) -> TreeModel:
     """Bin the samples and grow the tree; `discretiser` may be 'authors' or 'entropy'.
 
     'authors' means the authors' bins in image mode and the dead-zoned sign bins on the
     ground velocity in ground mode; 'entropy' fits MDL cut points on these samples.
+    The tree splits on the case labels either way (the paper's ID3); `leaf_value` says
+    what its nodes then carry, `shrink` (rows) pulls velocity gains toward 1.
     """
+    if leaf_value is LeafValue.VELOCITY_GAIN:
+        if mode is not Mode.IMAGE:
+            raise ValueError("velocity-gain leaves are for image mode only")
+        if any(s.velocity_displacement is None for s in samples):
+            raise ValueError("velocity-gain leaves need each sample's velocity displacement")
+    if not (math.isfinite(shrink) and shrink >= 0):
+        raise ValueError(f"shrink must be a finite number >= 0, got {shrink}")
     if not samples:
         raise ValueError("no training samples")
     if not horizon > 0:
@@ -122,8 +156,15 @@ def fit_model(
     if not np.all(np.isfinite(targets)):
         raise ValueError("training displacements must be finite")
     tree = fit_id3(rows, labels, disc.attributes, targets, params)
+    if leaf_value is LeafValue.VELOCITY_GAIN:
+        cv = np.array([s.velocity_displacement for s in samples], dtype=float)
+        if not np.all(np.isfinite(cv)):
+            raise ValueError("training velocity displacements must be finite")
+        root = _with_gains(tree.root, list(range(len(rows))), rows, targets, cv, shrink)
+        tree = DecisionTree(tree.attributes, root)
     gains = tuple((a, information_gain(rows, labels, a)) for a in disc.attributes)
     return TreeModel(
+        leaf_value=leaf_value,
         mode=mode,
         horizon=horizon,
         discretiser=disc,
@@ -132,6 +173,52 @@ def fit_model(
         root_gains=gains,
         provenance=dict(provenance or {}),
     )
+
+
+def velocity_gain(actual: np.ndarray, velocity: np.ndarray, shrink: float) -> float:
+    """The gain g minimising sum |actual - g * velocity|, shrunk toward 1 by n / (n + shrink).
+
+    The minimiser is the median of actual / velocity weighted by |velocity| (rows where
+    constant velocity moves nothing carry no weight); with no weight at all it is 1.
+    """
+    a, v = np.asarray(actual, dtype=float), np.asarray(velocity, dtype=float)
+    w = np.abs(v)
+    keep = w > 0
+    if not np.any(keep):
+        return 1.0
+    ratio, w = a[keep] / v[keep], w[keep]
+    order = np.argsort(ratio, kind="stable")
+    cum = np.cumsum(w[order])
+    raw = float(ratio[order][int(np.searchsorted(cum, cum[-1] / 2))])
+    n = int(a.size)
+    return 1.0 + n / (n + shrink) * (raw - 1.0)
+
+
+def _with_gains(
+    node: Node,
+    idx: list[int],
+    rows: Sequence[Mapping[str, int]],
+    actual: np.ndarray,
+    velocity: np.ndarray,
+    shrink: float,
+) -> Node:
+    """`node` and its subtree with `mean` replaced by the velocity gains of their rows."""
+    gains = tuple(velocity_gain(actual[idx, ax], velocity[idx, ax], shrink) for ax in range(2))
+    branches = tuple(
+        (
+            v,
+            _with_gains(
+                child,
+                [i for i in idx if rows[i][node.attribute or ""] == v],
+                rows,
+                actual,
+                velocity,
+                shrink,
+            ),
+        )
+        for v, child in node.branches
+    )
+    return replace(node, mean=gains, branches=branches)
 
 
 @dataclass(frozen=True)
@@ -183,6 +270,14 @@ class TreePredictor:
     ) -> tuple[Prediction, Ops]:
         mean = decision.node.mean
         h = features.apparent_height
+        gain_leaf = self.model.leaf_value is LeafValue.VELOCITY_GAIN
+        if self.placement is Placement.LEAF and mean is not None and gain_leaf:
+            # offset = gain * v * horizon per axis (4 multiplies); centre and foot shifted.
+            dx = mean[0] * _finite_or_zero(features.vx) * horizon
+            dy = mean[1] * _finite_or_zero(features.vy) * horizon
+            (cu, cv), (fu, fv) = features.center, features.foot
+            pred = Prediction(decision.case, horizon, (cu + dx, cv + dy), (fu + dx, fv + dy))
+            return pred, GAIN_PLACEMENT_OPS
         if self.placement is Placement.LEAF and mean is not None and _positive(h):
             # s = h * horizon / H; offset = mean * s; centre and foot shifted by it.
             s = h * horizon / self.model.horizon
@@ -213,6 +308,9 @@ class TreePredictor:
 # The height check (finite, positive), then s = h * horizon / H (2), the offset (2
 # multiplies) and the shifted centre and foot (4 additions).
 LEAF_PLACEMENT_OPS = Ops(comparisons=2, arithmetic=8)
+# Two finite checks on the velocity, gain * v * horizon on both axes (4 multiplies) and
+# the shifted centre and foot (4 additions).
+GAIN_PLACEMENT_OPS = Ops(comparisons=2, arithmetic=8)
 
 
 def extrapolation_ops(case: Case) -> Ops:

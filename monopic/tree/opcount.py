@@ -22,7 +22,9 @@ from monopic.cases import Case
 from monopic.features.record import Features
 from monopic.predict.base import Mode
 from monopic.tree.model import (
+    GAIN_PLACEMENT_OPS,
     LEAF_PLACEMENT_OPS,
+    LeafValue,
     Placement,
     TreePredictor,
     extrapolation_ops,
@@ -79,7 +81,11 @@ def worst_case_prediction_ops(predictor: TreePredictor) -> PredictionOps:
     if predictor.model.mode is not Mode.IMAGE:
         raise ValueError("operation counts cover image mode (the paper's method) only")
     case_ops = max((extrapolation_ops(c) for c in Case), key=lambda o: o.total)
-    if predictor.placement is Placement.LEAF:
+    if predictor.placement is Placement.LEAF and (
+        predictor.model.leaf_value is LeafValue.VELOCITY_GAIN
+    ):
+        placement = GAIN_PLACEMENT_OPS
+    elif predictor.placement is Placement.LEAF:
         placement = max(LEAF_PLACEMENT_OPS, case_ops + Ops(comparisons=2), key=lambda o: o.total)
     else:
         placement = case_ops

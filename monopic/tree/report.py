@@ -5,7 +5,7 @@ from __future__ import annotations
 from monopic.cases import Case
 from monopic.predict.base import Mode
 from monopic.tree.id3 import Node, Value, render_dot, render_text
-from monopic.tree.model import Placement, TreeModel, TreePredictor
+from monopic.tree.model import LeafValue, Placement, TreeModel, TreePredictor
 from monopic.tree.opcount import ops_report
 
 # The paper's root information gains ("ID3 Classification"), image mode.
@@ -35,11 +35,17 @@ def _node_text(model: TreeModel, node: Node) -> str:
     case = Case(node.label)
     text = f"case {int(case)} {case.label} (n={node.n}, {node.purity:.0%})"
     if node.mean is not None:
-        unit = "heights" if model.mode is Mode.IMAGE else "m"
-        text += f", moves ({node.mean[0]:+.2f}, {node.mean[1]:+.2f}) {unit}"
+        text += f", {_leaf_text(model, node.mean)}"
     if not node.is_leaf:
         text += f"; split on {node.attribute} (gain {node.gain:.3f})"
     return text
+
+
+def _leaf_text(model: TreeModel, mean: tuple[float, ...]) -> str:
+    if model.leaf_value is LeafValue.VELOCITY_GAIN:
+        return f"velocity gain ({mean[0]:.2f}, {mean[1]:.2f})"
+    unit = "heights" if model.mode is Mode.IMAGE else "m"
+    return f"moves ({mean[0]:+.2f}, {mean[1]:+.2f}) {unit}"
 
 
 def tree_text(model: TreeModel) -> str:
@@ -55,7 +61,7 @@ def tree_dot(model: TreeModel) -> str:
         case = Case(node.label)
         text = f"case {int(case)}: {case.label}\nn={node.n} ({node.purity:.0%})"
         if node.mean is not None:
-            text += f"\nmoves ({node.mean[0]:+.2f}, {node.mean[1]:+.2f})"
+            text += f"\n{_leaf_text(model, node.mean)}"
         return text
 
     return render_dot(
@@ -71,11 +77,13 @@ def summary(model: TreeModel) -> str:
     data = model.provenance.get("data", [])
     trained = ", ".join(f"{d['name']} ({d['training_rows']} rows)" for d in data) or "unknown"
     unit = "apparent heights" if model.mode is Mode.IMAGE else "metres"
+    leaves = f"leaf displacements in {unit}"
+    if model.leaf_value is LeafValue.VELOCITY_GAIN:
+        leaves = "leaves: gains on the measured velocity (x, y)"
     parts = [
         f"ID3 tree, {model.mode.value} mode, horizon {model.horizon:g} s, "
         f"discretiser {model.discretiser.name}, depth {model.tree.depth}, "
-        f"{sum(1 for n in model.tree.nodes() if n.is_leaf)} leaves; "
-        f"leaf displacements in {unit}",
+        f"{sum(1 for n in model.tree.nodes() if n.is_leaf)} leaves; {leaves}",
         f"Trained on: {trained}",
         "",
         gain_table(model),

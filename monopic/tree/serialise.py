@@ -3,6 +3,11 @@
 The file is plain JSON so anyone can read the tree without our code. Floats are written
 with Python's shortest round-trip repr, so load(save(model)) == model exactly. A file
 with another format name or version is refused with a clear message rather than guessed.
+
+Version 1: leaves carry displacements. Version 2 adds "leaf_value" ("displacement" or
+"velocity-gain"); a tree with displacement leaves is still written as version 1 (so the
+shipped tree's file does not change), one with gain leaves as version 2, which a version-1
+reader refuses instead of reading gains as displacements. Both versions load.
 """
 
 from __future__ import annotations
@@ -18,17 +23,21 @@ from monopic.output import write_text_atomically
 from monopic.predict.base import Mode
 from monopic.tree.discretise import Discretiser
 from monopic.tree.id3 import DecisionTree
-from monopic.tree.model import TreeModel, TreePredictor
+from monopic.tree.model import LeafValue, TreeModel, TreePredictor
 
 FORMAT = "monopic-id3-tree"
-VERSION = 1
+VERSION = 2
+VERSIONS = (1, 2)
 DEFAULT_TREE_NAME = "default_tree.json"
 
 
 def model_to_json(model: TreeModel) -> dict[str, Any]:
+    displacement = model.leaf_value is LeafValue.DISPLACEMENT
+    extra = {} if displacement else {"leaf_value": model.leaf_value.value}
     return {
         "format": FORMAT,
-        "version": VERSION,
+        "version": 1 if displacement else VERSION,
+        **extra,
         "mode": model.mode.value,
         "horizon_s": model.horizon,
         "displacement_unit": model.displacement_unit,
@@ -46,11 +55,20 @@ def model_from_json(data: Any) -> TreeModel:
         raise ValueError("not a JSON object")
     if data.get("format") != FORMAT:
         raise ValueError(f"format is {data.get('format')!r}, expected {FORMAT!r}")
-    if data.get("version") != VERSION:
-        raise ValueError(f"version {data.get('version')!r} is not supported (only {VERSION})")
+    version = data.get("version")
+    if version not in VERSIONS:
+        raise ValueError(f"version {version!r} is not supported (only {VERSIONS})")
+    if version == 1 and "leaf_value" in data:
+        raise ValueError("leaf_value is a version-2 field; this file says version 1")
+    try:
+        leaf_value = LeafValue(data.get("leaf_value", LeafValue.DISPLACEMENT.value))
+    except ValueError:
+        known = ", ".join(v.value for v in LeafValue)
+        raise ValueError(f"leaf_value {data.get('leaf_value')!r} is not one of {known}") from None
     try:
         mode = Mode(data["mode"])
         model = TreeModel(
+            leaf_value=leaf_value,
             mode=mode,
             horizon=float(data["horizon_s"]),
             discretiser=Discretiser.from_json(data["discretiser"]),

@@ -251,8 +251,8 @@ def test_model_file_round_trip(tmp_path):
     assert dumps(back) == path.read_text()
     data = json.loads(path.read_text())
     assert data["format"] == "monopic-id3-tree" and data["version"] == 1
-    data["version"] = 2
-    with pytest.raises(ValueError, match="version 2"):
+    data["version"] = 3
+    with pytest.raises(ValueError, match="version 3"):
         model_from_json(data)
     data["version"] = 1
     data["tree"]["root"]["label"] = 12
