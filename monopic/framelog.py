@@ -1,6 +1,6 @@
 """Per-frame CSV rows: the authors' log columns, then ours.
 
-The authors' columns (tests/data/authors/README.md) let their analysis and our replay
+The authors' columns (../shared/data/authors-testdata/README.md) let their analysis and our replay
 read our runs; ours add the case, foot and ground points and per-stage milliseconds.
 """
 

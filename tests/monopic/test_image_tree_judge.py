@@ -35,10 +35,9 @@ from monopic.tree.model import (
 )
 from monopic.tree.opcount import prediction_ops, worst_case_prediction_ops
 from monopic.tree.serialise import dumps, load_default_model, load_model, model_from_json
-from tests.paths import ROOT
+from tests.paths import AUTHORS_LOGS
 
-# The authors' logs, read where the workspace keeps them (never copied for this test).
-SHARED_LOGS = ROOT.parent / "shared" / "data" / "authors-testdata"
+SHARED_LOGS = AUTHORS_LOGS  # read where the workspace keeps them, never copied
 DT = 0.05
 HEIGHT_PX = 200.0
 

@@ -11,9 +11,7 @@ import pytest
 from monopic.cli.main import main
 from monopic.errors import UserError
 from monopic.replay.logs import COLUMNS, read_log
-from tests.paths import DATA
-
-LOGS = DATA / "authors"
+from tests.paths import AUTHORS_LOGS, needs_authors_logs
 
 
 def rows(n: int = 4) -> list[dict[str, float]]:
@@ -40,13 +38,17 @@ def write(path: Path, table: list[dict[str, float]]) -> Path:
     return path
 
 
-def test_a_plausible_log_and_the_authors_logs_load(tmp_path: Path) -> None:
+def test_a_plausible_log_loads(tmp_path: Path) -> None:
     assert len(read_log(write(tmp_path / "ok.csv", rows()))) == 4
     first = rows()
     first[0]["fps"] = 0.0  # the authors' logs: no rate yet on the first row
     assert len(read_log(write(tmp_path / "first.csv", first))) == 4
+
+
+@needs_authors_logs
+def test_the_authors_logs_load() -> None:
     for k in range(4):
-        read_log(LOGS / f"data{k}.csv")
+        read_log(AUTHORS_LOGS / f"data{k}.csv")
 
 
 @pytest.mark.parametrize(

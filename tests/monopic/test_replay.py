@@ -20,12 +20,13 @@ from monopic.replay.run import AUTHORS, STILL, replay
 from monopic.replay.training import TrainOptions, train_on_logs
 from monopic.tree.model import TrainingSample, fit_model
 from monopic.tree.serialise import DEFAULT_TREE_NAME, dumps, save_model
-from tests.paths import DATA, ROOT
+from tests.paths import AUTHORS_LOGS, ROOT, needs_authors_logs
 
-LOGS = DATA / "authors"
+LOGS = AUTHORS_LOGS
 PAPER_FIGURES = {"data0": 0.8764, "data1": 0.7698, "data2": 0.9085, "data3": 0.9157}
 
 
+@needs_authors_logs
 @pytest.mark.parametrize(("name", "figure"), sorted(PAPER_FIGURES.items()))
 def test_paper_metric_gives_the_authors_figures_exactly(name, figure):
     log = read_log(LOGS / f"{name}.csv")
@@ -107,6 +108,7 @@ def _all_logs():
     return [prepare(read_log(LOGS / f"data{k}.csv")) for k in range(4)]
 
 
+@needs_authors_logs
 def test_leave_one_file_out_never_trains_on_the_judged_file():
     logs = _all_logs()
     results = replay(logs, None, TrainOptions())
@@ -117,6 +119,7 @@ def test_leave_one_file_out_never_trains_on_the_judged_file():
         assert not r.in_sample
 
 
+@needs_authors_logs
 def test_shipped_default_tree_is_reproduced_by_its_documented_command(tmp_path):
     shipped = ROOT / "monopic" / "tree" / DEFAULT_TREE_NAME
     model = train_on_logs(_all_logs(), TrainOptions())
@@ -127,6 +130,7 @@ def test_shipped_default_tree_is_reproduced_by_its_documented_command(tmp_path):
     assert out.read_text() == shipped.read_text()
 
 
+@needs_authors_logs
 def test_replay_cli_writes_every_row_and_flags_in_sample(tmp_path, capsys):
     shipped = ROOT / "monopic" / "tree" / DEFAULT_TREE_NAME
     out = tmp_path / "pred.csv"
@@ -195,6 +199,7 @@ def test_bad_tree_file(tmp_path, capsys):
     assert err.count("\n") == 1 and "tree.json" in err and "version 7" in err
 
 
+@needs_authors_logs
 def test_replay_refuses_a_ground_tree(tmp_path, capsys):
     samples = [
         TrainingSample({"forward": -1.0, "left": 0.0}, Case.TOWARD, (-1.0, 0.0)),

@@ -97,9 +97,15 @@ def test_every_command_makes_the_folder_its_output_goes_to(
     """One rule for output paths (README): a missing folder is created, for tree and replay
     here; video (test_cli_video_errors), sweep and report (test_sweep), closed-loop and
     dataset (below) and record (tests/test_walkthrough.py) in their own tests."""
-    from tests.paths import DATA
+    import numpy as np
 
-    logs = sorted((DATA / "authors").glob("data*.csv"))
+    from tests.monopic.test_image_tree_judge import write_log
+
+    t = np.arange(0.0, 8.0, 0.05)  # three hand-made walks in the authors' log format
+    logs = [
+        write_log(tmp_path / f"walk{k}.csv", t, 200 + v * t, 240 + 0 * t, phi)
+        for k, (v, phi) in enumerate([(40.0, 90.0), (-30.0, 150.0), (0.0, 30.0)])
+    ]
     tree = tmp_path / "a" / "b" / "tree.json"
     assert main(["tree", "train", *map(str, logs[:2]), "--out", str(tree)]) == 0
     assert tree.is_file()
