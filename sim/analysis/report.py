@@ -229,9 +229,14 @@ def sweeps_line(rows: Sequence[RunResult]) -> str:
 
 
 def write_report(
-    m: SweepMetrics, rows: Sequence[RunResult], results: Path, out_dir: Path
+    m: SweepMetrics,
+    rows: Sequence[RunResult],
+    results: Path,
+    out_dir: Path,
+    beside: tuple[str, SweepMetrics] | None = None,
 ) -> Report:
-    """Write report.md and its plots into out_dir (created); returns what was written."""
+    """Write report.md and its plots into out_dir (created); returns what was written.
+    `beside` (a name and another sweep's metrics) adds that sweep's figures cell by cell."""
     out_dir.mkdir(parents=True, exist_ok=True)
     footer = ran_on(m)
     main_methods = [x for x in m.methods if split_method(x)[0] == MAIN]
@@ -401,6 +406,10 @@ def write_report(
         ),
         "",
     ]
+    if beside is not None:
+        from sim.analysis.beside import beside_lines
+
+        lines += beside_lines(m, beside[1], results.stem, beside[0], main_methods)
     markdown = out_dir / "report.md"
     write_text_atomically(markdown, "\n".join(lines))
     return Report(markdown, tuple(written), headline(m))

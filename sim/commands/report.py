@@ -22,6 +22,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         type=Path,
         help="report folder, made as needed (default: beside RESULTS, <name>_report/)",
     )
+    p.add_argument(
+        "--beside",
+        type=Path,
+        metavar="OTHER.jsonl",
+        help="another sweep's results file (the same families, e.g. human beside rail "
+        "walkers): the report adds its figures beside this one's, per method and family "
+        "(default: none)",
+    )
     p.set_defaults(func=run)
 
 
@@ -41,7 +49,16 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"{results}: no finished runs in it yet")
     out = output_folder(args.out or results.with_name(f"{results.stem}_report"), "--out")
     metrics = compute(rows)
-    report = write_report(metrics, rows, results, out)
+    beside = None
+    if args.beside is not None:
+        if not args.beside.is_file():
+            raise UserError(f"--beside {args.beside}: no such results file")
+        check_results_file(args.beside)
+        other = list(read_results(args.beside))
+        if not other:
+            raise UserError(f"--beside {args.beside}: no finished runs in it yet")
+        beside = (args.beside.stem, compute(other))
+    report = write_report(metrics, rows, results, out, beside)
     print(report.headline)
     print(f"\n{ran_on(metrics)}")
     print(sweeps_line(rows).replace("`", ""))

@@ -262,3 +262,18 @@ def test_every_predictor_and_mode_has_its_own_colour_in_the_plots() -> None:
     assert len(set(colours)) == len(keys)
     assert style("gtcrop:rules/image")["color"] == style("rules/image")["color"]
     assert style("mine/image")["color"] == style("mine/image")["color"] not in colours
+
+
+def test_two_sweeps_beside_each_other_cell_by_cell(tmp_path: Path) -> None:
+    from sim.analysis.beside import beside_rows
+
+    rail = compute([collision_row("a", 9, family="f1"), near_miss_row("d", {3})])
+    human = compute([collision_row("a", None, family="f1"), collision_row("b", 9, family="f2")])
+    (overall,) = beside_rows(rail, human, [KEY], by_family=False)
+    assert overall[:4] == [KEY, "2 / 2", "1 / 2", "100 % [21] / 50 % [9]"]
+    assert overall[5] == "1/1 / -"  # near misses: only the first sweep has one
+    fam = {(r[0], r[1]): r for r in beside_rows(rail, human, [KEY], by_family=True)}
+    assert fam[("f1", KEY)][4] == "100 % [21] / 0 % [0]"
+    assert fam[("f2", KEY)][3] == "- / 1"  # a family only the other sweep holds
+    report = write_report(rail, [], tmp_path / "rail.jsonl", tmp_path / "rep", ("human", human))
+    assert "## Beside human" in report.markdown.read_text()
