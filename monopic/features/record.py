@@ -20,8 +20,9 @@ class GroundFeatures:
     position: Point  # (forward, left) metres
     velocity: Point  # the pedestrian's own ground velocity (forward, left), m/s
     camera: CameraModel  # the robot's own camera, to draw ground predictions on the image
-    # Intent features (window.GroundKinematics: a 0.8 s fit, not the track above, which
-    # the constant-velocity baseline reads); NaN until the window is full enough.
+    # Intent features (window.GroundKinematics: a 1 s fit read at its centre, about 0.5 s
+    # ago; not the track above, which the constant-velocity baseline reads); NaN until
+    # the window is full enough.
     speed: float = _NAN  # m/s over the ground
     acceleration: float = _NAN  # m/s^2 along the walking direction (< 0 slowing)
     heading_rate: float = _NAN  # deg/s, > 0 turning left (counter-clockwise from above)
