@@ -104,7 +104,8 @@ class GroundMotion:
         return position, self.odometry.rotate_to_robot((float(v[0]), float(v[1])))
 
     def kinematics(self) -> Kinematics:
-        """The window fit's speed, along-track acceleration and heading rate now."""
+        """The window fit's speed, along-track acceleration and heading rate, read at the
+        window's centre (`Kinematics.age` seconds before the newest measurement)."""
         return self._kinematics.estimate()
 
     def reset_track(self) -> None:

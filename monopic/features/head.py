@@ -15,9 +15,9 @@ raises atan2(z, x) of every line across the body.
 The nose is not used for the angle: its depth ahead of the ears enters with BlazePose's
 z scale differently than a line across the head does, so mixing the two would bias the
 angle wherever that scale is off; lines across shoulders and head share the same bias
-and it cancels at zero yaw. Ears are required (both: an ear hidden behind the head,
-as in profile, gives no head line); the eyes add a second head line when both are
-visible (facing the camera), which averages down their noise.
+and it cancels at zero yaw. Both ears are required (one BlazePose marks hidden gives
+no head line; in practice it marks ears visible even in profile); the eyes add a second
+head line when both are visible, which averages down their noise.
 """
 
 from __future__ import annotations

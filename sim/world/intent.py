@@ -10,10 +10,12 @@ Four classes, from the pedestrian's true Track (sim.scenario.path) over (t, t + 
 - stop: moving now (own ground speed at least the dead zone, monopic.cases'
   GROUND_DEAD_ZONE_MPS) and the speed falls below it within the horizon. Read on the
   Track's own pieces, so the time is exact: a stop reached exactly at the horizon counts.
-- turn away: walking now, the direction turns away from the path's centre line by as
-  much as `dead_zone` of lateral speed at the speed now (the share of the walk toward
-  the centre line drops by dead_zone / speed), while the pedestrian still walks: a
-  crossing walker turning to walk along the kerb or back, one walking along the path
+- turn away: walking now (the trailing mean speed below at the dead zone or more), the
+  direction turns away from the path's centre line by as much as `dead_zone` of lateral
+  speed at the speed now (the share of the walk toward the centre line drops by
+  dead_zone / speed), while the pedestrian still walks (trailing mean and Track speed
+  at the dead zone or more: a stopped walker's mean moves on for a while): a crossing
+  walker turning to walk along the kerb or back, one walking along the path
   stepping aside. Standing now: walking off away from the path at the dead zone or more;
 - start crossing: walking now, the direction turns toward the centre line by as much
   (one walking along the kerb turning in), and the lateral speed toward it reaches the
@@ -22,8 +24,8 @@ Four classes, from the pedestrian's true Track (sim.scenario.path) over (t, t + 
   or speeding up on the same line is neither;
 - keep going: none of these (walking on as now, standing on, or crossing on).
 
-The lateral speeds are mean velocities over the trailing `smoothing` seconds (0.5 s,
-about a step and a half): a human walker's stride surge (12 % of its speed twice a
+Turns are read on mean velocities over the trailing `smoothing` seconds (0.5 s, about
+one step at 1.8 steps/s): a human walker's stride surge (12 % of its speed twice a
 stride) and sway would otherwise read as turns. Trailing, so an event at time tau means
 the motion up to tau already shows it; "now" is the last half second, what the robot
 could have seen. Turn events are found on a `step` grid (0.05 s) in (t, t + horizon].
@@ -48,6 +50,8 @@ ON_CENTRE_M = 1e-3  # m: closer to the centre line than this, the pedestrian has
 
 
 class Intent(StrEnum):
+    """What the pedestrian does within the horizon, against the robot's path."""
+
     KEEP_GOING = "keep going"
     STOP = "stop"
     TURN_AWAY = "turn away"
