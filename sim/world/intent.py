@@ -107,11 +107,9 @@ def first_slow_time(track: Track, t: float, horizon: float, dead_zone: float) ->
     end = t + horizon
     k0 = int(np.searchsorted(track.times, t, side="right")) - 1
     k1 = int(np.searchsorted(track.times, end, side="right")) - 1
-    speeds = np.hypot(track.velocities[:, 0], track.velocities[:, 1])
-    for k in range(k0, k1 + 1):
-        if speeds[k] < dead_zone:
-            return max(float(track.times[k]), t)
-    return None
+    v = track.velocities[k0 : k1 + 1]
+    slow = np.flatnonzero(np.hypot(v[:, 0], v[:, 1]) < dead_zone)
+    return max(float(track.times[k0 + slow[0]]), t) if slow.size else None
 
 
 def intent_label(
