@@ -24,6 +24,9 @@ OUR_COLUMNS = (
     "apparentHeight", "poseScore", "collision", "risk", "groundX", "groundY", "groundVx",
     "groundVy", "predictedGroundX", "predictedGroundY", "detectorRuns", "detectMs",
     "landmarksMs", "featuresMs", "predictMs", "warningMs", "totalMs",
+    # Intent features (docs/intent/features.md), empty where not known.
+    "phiRate", "headYaw", "headVisibility", "groundSpeed", "groundAcceleration",
+    "groundHeadingRate", "pathOffset", "pathDistance",
 )  # fmt: skip
 FRAME_COLUMNS = AUTHORS_COLUMNS + OUR_COLUMNS
 
@@ -54,7 +57,16 @@ def frame_row(r: FrameResult, fps: float, horizon: float) -> list:
         r.pose.detector_runs, f"{ms.get('detect', nan):.3f}", f"{ms.get('landmarks', nan):.3f}",
         f"{ms.get('features', nan):.3f}", f"{ms.get('predict', nan):.3f}",
         f"{ms.get('warning', nan):.3f}", f"{ms.get('total', nan):.3f}",
+        _cell(f.phi_rate, 2), _cell(f.head_yaw, 2), _cell(f.head_visibility, 3),
+        _cell(g.speed if g else nan, 3), _cell(g.acceleration if g else nan, 3),
+        _cell(g.heading_rate if g else nan, 2), _cell(g.path_offset if g else nan, 3),
+        _cell(g.path_distance if g else nan, 3),
     ]  # fmt: skip
+
+
+def _cell(value: float, digits: int) -> str:
+    """A number with `digits` decimals; empty when not known (NaN)."""
+    return f"{value:.{digits}f}" if math.isfinite(value) else ""
 
 
 def authors_finite(row: list) -> bool:

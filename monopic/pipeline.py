@@ -119,7 +119,7 @@ class Pipeline:
         if len(set(keys)) != len(keys):
             raise ValueError(f"predictors must differ by name or mode, got {keys}")
         self.tracker = PoseTracker(self.config.tracker)
-        self.features = FeatureExtractor()
+        self.features = FeatureExtractor(robot_width=self.config.warning.robot.width)
 
     @property
     def primary(self) -> str:

@@ -8,16 +8,22 @@ import numpy as np
 
 from monopic.features.ground import GroundMotion
 from monopic.features.ground_track import GroundTrackConfig
+from monopic.features.head import MIN_HEAD_VISIBILITY, head_yaw
 from monopic.features.motion import VelocityEstimator
 from monopic.features.orientation import facing_angle
 from monopic.features.record import Features, GroundFeatures
 from monopic.features.smoothing import Kalman1D
+from monopic.features.swept_path import path_offset
+from monopic.features.window import KinematicsConfig, SlidingWindow, angle_rate
 from monopic.frame import EgoState
 from monopic.pose.landmarks import Pose
 from monopic.pose.skeleton import FOOT_LANDMARKS, LEFT_SHOULDER, RIGHT_SHOULDER
 
 # Foot landmarks below this visibility are not trusted for the foot point.
 MIN_FOOT_VISIBILITY = 0.5
+# The default robot's width, m: monopic.variants.zone.RobotGeometry's (the pipeline passes
+# its own robot's; features cannot import the variants above them).
+DEFAULT_ROBOT_WIDTH = 0.6
 
 
 def foot_point(pose: Pose, image_height: int) -> tuple[float, float]:
@@ -44,13 +50,20 @@ class FeatureExtractor:
     ground_track: GroundTrackConfig = field(default_factory=GroundTrackConfig)
     max_gap: float = 0.5  # seconds without a pose before the track's history is dropped
     phi_filter: Kalman1D = field(default_factory=Kalman1D)
+    # Intent features: none of them feeds today's predictors.
+    kinematics: KinematicsConfig = field(default_factory=KinematicsConfig)
+    phi_rate_window: float = 0.5  # s: a shoulder turn leading a walking turn takes ~0.5 s
+    robot_width: float = DEFAULT_ROBOT_WIDTH  # m, the swept path's width
+    min_head_visibility: float = MIN_HEAD_VISIBILITY
     _image_velocity: VelocityEstimator = field(init=False)
     _ground: GroundMotion = field(init=False)
+    _phi_history: SlidingWindow = field(init=False)
     _last_seen: float | None = field(default=None, init=False)
 
     def __post_init__(self) -> None:
         self._image_velocity = VelocityEstimator(self.velocity_window, self.velocity_average)
-        self._ground = GroundMotion(self.ground_track)
+        self._ground = GroundMotion(self.ground_track, kinematics_config=self.kinematics)
+        self._phi_history = SlidingWindow(self.phi_rate_window)
 
     def update(
         self, timestamp: float, pose: Pose | None, image_height: int, ego: EgoState | None = None
@@ -71,12 +84,25 @@ class FeatureExtractor:
         foot = foot_point(pose, image_height)
         phi_raw = facing_angle(pose.landmarks[LEFT_SHOULDER], pose.landmarks[RIGHT_SHOULDER])
         phi = self.phi_filter.update(phi_raw)
+        self._phi_history.add(timestamp, phi)
         vx, vy = self._image_velocity.update(timestamp, *center)
+        head = head_yaw(pose.landmarks, pose.visibility, self.min_head_visibility)
         ground = None
         if ego is not None:
             g = self._ground.update(timestamp, ego, foot, pose.height)
             if g is not None:
-                ground = GroundFeatures(position=g[0], velocity=g[1], camera=ego.camera)
+                k = self._ground.kinematics()
+                side = path_offset(g[0], self.robot_width)
+                ground = GroundFeatures(
+                    position=g[0],
+                    velocity=g[1],
+                    camera=ego.camera,
+                    speed=k.speed,
+                    acceleration=k.acceleration,
+                    heading_rate=k.heading_rate,
+                    path_offset=side.offset,
+                    path_distance=side.distance,
+                )
         return Features(
             timestamp=timestamp,
             center=center,
@@ -87,9 +113,13 @@ class FeatureExtractor:
             vy=vy,
             ground=ground,
             phi_raw=phi_raw,
+            phi_rate=angle_rate(self._phi_history),
+            head_yaw=head.yaw,
+            head_visibility=head.visibility,
         )
 
     def _reset_track(self) -> None:
         self._image_velocity.reset()
         self._ground.reset_track()
         self.phi_filter.reset()
+        self._phi_history.reset()

@@ -5,6 +5,10 @@ speed and yaw rate, so it integrates them into an odometry pose, tracks the pede
 foot point in that fixed odometry frame (a Kalman filter, `ground_track`, fed each foot
 point with its pixel noise carried onto the ground), and rotates position and velocity
 back into its current frame. The result is the pedestrian's own ground velocity.
+
+Beside the track, the measurements it believed also go into a short window fit
+(`window.GroundKinematics`) for the intent features: speed, acceleration along the
+walking direction and heading rate. The track's own outputs do not depend on it.
 """
 
 from __future__ import annotations
@@ -15,6 +19,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from monopic.features.ground_track import GroundTrack, GroundTrackConfig
+from monopic.features.window import GroundKinematics, Kinematics, KinematicsConfig
 from monopic.frame import EgoState
 
 
@@ -60,10 +65,13 @@ class GroundMotion:
 
     config: GroundTrackConfig = field(default_factory=GroundTrackConfig)
     odometry: Odometry = field(default_factory=Odometry)
+    kinematics_config: KinematicsConfig = field(default_factory=KinematicsConfig)
     _track: GroundTrack = field(init=False)
+    _kinematics: GroundKinematics = field(init=False)
 
     def __post_init__(self) -> None:
         self._track = GroundTrack(self.config)
+        self._kinematics = GroundKinematics(self.kinematics_config)
 
     def observe_ego(self, t: float, ego: EgoState) -> None:
         """Advance odometry; call on every frame, with or without a pedestrian."""
@@ -85,13 +93,24 @@ class GroundMotion:
         g, cov = measured
         rot = self.odometry.rotation()
         z = np.array(self.odometry.to_fixed((float(g[0]), float(g[1]))))
-        self._track.update(t, z, rot @ cov @ rot.T)
+        R = rot @ cov @ rot.T
+        starts = self._track.starts
+        if self._track.update(t, z, R):  # the window believes what the track believes
+            if self._track.starts != starts:
+                self._kinematics.reset()  # a restart: another person, or a jump
+            self._kinematics.add(t, z, R)
         p, v = self._track.position, self._track.velocity
         position = self.odometry.to_robot((float(p[0]), float(p[1])))
         return position, self.odometry.rotate_to_robot((float(v[0]), float(v[1])))
 
+    def kinematics(self) -> Kinematics:
+        """The window fit's speed, along-track acceleration and heading rate, read at the
+        window's centre (`Kinematics.age` seconds before the newest measurement)."""
+        return self._kinematics.estimate()
+
     def reset_track(self) -> None:
         self._track.reset()
+        self._kinematics.reset()
 
     def _pixel_noise(self, apparent_height: float) -> float:
         h = apparent_height if math.isfinite(apparent_height) and apparent_height > 0 else 0.0

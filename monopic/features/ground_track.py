@@ -63,6 +63,7 @@ class GroundTrack:
     P: np.ndarray | None = None
     t: float | None = None
     rejected: int = 0
+    starts: int = 0  # times the track (re)started: a window fed from it restarts too
 
     def update(self, t: float, z: np.ndarray, R: np.ndarray) -> bool:
         """Fold in a position measurement `z` (2,) with covariance `R` (2, 2) taken at `t`.
@@ -117,6 +118,7 @@ class GroundTrack:
         self.P[2:, 2:] = np.eye(2) * s2
         self.t = t
         self.rejected = 0
+        self.starts += 1
 
     def _predicted(self, dt: float) -> tuple[np.ndarray, np.ndarray]:
         assert self.x is not None and self.P is not None

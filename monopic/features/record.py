@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from monopic.camera import CameraModel
 
 Point = tuple[float, float]
+_NAN = float("nan")
 
 
 @dataclass(frozen=True)
@@ -19,6 +20,15 @@ class GroundFeatures:
     position: Point  # (forward, left) metres
     velocity: Point  # the pedestrian's own ground velocity (forward, left), m/s
     camera: CameraModel  # the robot's own camera, to draw ground predictions on the image
+    # Intent features (window.GroundKinematics: a 1 s fit read at its centre, about 0.5 s
+    # ago; not the track above, which the constant-velocity baseline reads); NaN until
+    # the window is full enough.
+    speed: float = _NAN  # m/s over the ground
+    acceleration: float = _NAN  # m/s^2 along the walking direction (< 0 slowing)
+    heading_rate: float = _NAN  # deg/s, > 0 turning left (counter-clockwise from above)
+    # Against the robot's swept path (swept_path.py): the band of its width along x.
+    path_offset: float = _NAN  # m, signed from the path's centre line, + left
+    path_distance: float = _NAN  # m, lateral distance to the band's nearer edge, 0 inside
 
 
 @dataclass(frozen=True)
@@ -27,6 +37,8 @@ class Features:
 
     Image quantities are pixels (u right, v down) and px/s; phi is the paper's facing
     angle in degrees (smoothed); `ground` is present only when the camera model is known.
+    Intent features after `phi_raw` default to NaN (not computed), so a record built
+    without them means what it meant before they existed.
     """
 
     timestamp: float
@@ -37,4 +49,7 @@ class Features:
     vx: float
     vy: float
     ground: GroundFeatures | None = None
-    phi_raw: float = float("nan")
+    phi_raw: float = _NAN
+    phi_rate: float = _NAN  # deg/s, least-squares slope of the smoothed phi over 0.5 s
+    head_yaw: float = _NAN  # deg, head from the shoulders, + to the person's left (head.py)
+    head_visibility: float = _NAN  # 0-1, min visibility of the ears and shoulders

@@ -9,7 +9,7 @@ one image. For each run the folder gets:
 - masks/<run>/<frame>.png: the pedestrian's pixels from MuJoCo's segmentation rendering
   (0/255; occluders hide it as in the image);
 - truth/<run>.jsonl: one line per frame, GroundTruth.to_dict() plus the case label and
-  the image and mask file names;
+  the image and mask file names (the intent labels, sim.world.intent, among the truth);
 - features/<run>.csv: the pipeline's own per-frame output in the authors' log columns
   (monopic.framelog.AUTHORS_COLUMNS, then ours), the rows `monopic video --csv` writes
   whose authors' columns are all finite (not a track's first frame, which has no
@@ -438,7 +438,8 @@ FRAME_COLUMNS = (
     "run", "frame", "image", "mask", "time", "case", "case_name", "phi", "forward", "lateral",
     "velocity_forward", "velocity_left", "heading_robot_deg", "speed", "robot_speed",
     "time_to_collision", "collision", "contact", "in_frame", "occluded", "visible_fraction",
-    "box_u0", "box_v0", "box_u1", "box_v1", "foot_u", "foot_v",
+    "box_u0", "box_v0", "box_u1", "box_v1", "foot_u", "foot_v", "case_now", "intent",
+    "intent_time",
 )  # fmt: skip
 
 
@@ -460,6 +461,7 @@ def _frames_csv(out: Path, records: list[dict[str, Any]]) -> tuple[str, Counter]
                     math.degrees(t["heading_robot"]), t["speed"], t["robot"]["speed"],
                     t["time_to_collision"], int(t["collision"]), int(t["contact"]),
                     int(t["in_frame"]), int(t["occluded"]), t["visible_fraction"], *box, *foot,
+                    t["case_now"], t["intent"], t["intent_time"],
                 ]
             )  # fmt: skip
     return buf.getvalue(), cases

@@ -68,8 +68,10 @@ between invocations. Resumable: finished runs (`runs/<run>.json`) are skipped.
   no pixel of the person shows have no annotation;
 - `truth/<run>.jsonl`: per frame, the simulator's ground truth (`sim.world.ground_truth.
   GroundTruth.to_dict()`: positions in the world and the robot frame, velocities, case,
-  true phi, time to collision, collision, contact, landmark pixels, occlusion);
-- `frames.csv`: one row per image with the main truth columns;
+  true phi, time to collision, collision, contact, landmark pixels, occlusion, and the
+  labels `case_now` (the case of the velocity now) and `intent` (keep going, stop, turn
+  away or start crossing within the horizon; `intent_time` s until it happens);
+- `frames.csv`: one row per image with the main truth columns and those labels;
 - `features/<run>.csv`: the pipeline's own output per frame with a pose, in the MonoPIC
   authors' log columns then ours (as `monopic video --csv` writes), leaving out rows
   without a velocity yet (a track's first frame); `monopic tree train` and `monopic

@@ -9,6 +9,9 @@ posed MuJoCo mannequin (sim.world.body.PedestrianTruth). Conventions:
   unless named `relative_`;
 - the case is monopic.cases.case_from_ground_velocity of the pedestrian's mean own
   velocity over the next CASE_WINDOW seconds of its true path, in the robot's axes now;
+  `case_now` the same of the own velocity now; the intent class (keep going, stop, turn
+  away, start crossing) is what the true path does within the horizon against the
+  robot's path (sim.world.intent);
 - collision: the robot keeps its course (constant speed and heading) while the pedestrian
   follows its true path; both footprints are highway-env polygons (RoadObject.polygon)
   and "meet" means highway-env's separating-axis test (utils.are_polygons_intersecting)
@@ -40,6 +43,7 @@ from monopic.cases import Case, case_from_ground_velocity
 from sim.geometry.frames import Pose2D, wrap_angle
 from sim.geometry.polygons import polygon_gap, rectangle
 from sim.world.body import PedestrianTruth
+from sim.world.intent import Intent
 from sim.world.pedestrian import Pedestrian
 
 CASE_WINDOW = 1.0  # s of future motion that defines the ground-truth case
@@ -99,6 +103,9 @@ class GroundTruth:
     # The next CASE_WINDOW seconds and the horizon.
     case: Case
     case_velocity_robot: np.ndarray  # (2,) mean own velocity over the case window
+    case_now: Case  # the case of the own velocity now
+    intent: Intent  # what the true path does within the horizon (sim.world.intent)
+    intent_time: float | None  # s from now until it does it; None for keep going
     horizon: float
     future_position_world: np.ndarray  # (2,) where the path is at time + horizon
     future_position_robot: np.ndarray  # (2,) that point in the robot frame now
@@ -158,6 +165,9 @@ class GroundTruth:
             "heading_robot": self.heading_robot,
             "case": int(self.case),
             "case_velocity_robot": _plain(self.case_velocity_robot),
+            "case_now": int(self.case_now),
+            "intent": self.intent.value,
+            "intent_time": self.intent_time,
             "horizon": self.horizon,
             "future_position_world": _plain(self.future_position_world),
             "future_position_robot": _plain(self.future_position_robot),

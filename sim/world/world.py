@@ -50,6 +50,7 @@ from sim.world.ground_truth import (
     polygons_intersect,
     time_to_contact,
 )
+from sim.world.intent import intent_label
 from sim.world.pedestrian import Pedestrian
 from sim.world.render import Marker, RenderContext, SceneRenderer
 from sim.world.robot import Robot, highway_road
@@ -292,6 +293,7 @@ class World(Closing):
         ahead = path.state(self.time + CASE_WINDOW).position
         case, case_velocity = case_label((ahead - ped.position) / CASE_WINDOW, pose.yaw)
         future = path.state(self.time + scenario.horizon).position
+        intent = intent_label(path, self.time, pose, scenario.horizon)
 
         robot_polygon = self.robot.polygon()
         contact = polygons_intersect(robot_polygon, self.pedestrian.polygon())
@@ -326,6 +328,9 @@ class World(Closing):
             heading_robot=wrap_angle(ped.yaw - pose.yaw),
             case=case,
             case_velocity_robot=case_velocity,
+            case_now=intent.case_now,
+            intent=intent.intent,
+            intent_time=intent.time,
             horizon=scenario.horizon,
             future_position_world=future,
             future_position_robot=local(future),

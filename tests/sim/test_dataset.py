@@ -24,6 +24,7 @@ from sim.dataset.coco import (
     rle_counts,
 )
 from sim.dataset.spec import expand, load_spec
+from sim.world.intent import Intent
 from tests.paths import SCENARIOS
 
 CASE_GRID = SCENARIOS / "datasets" / "case_grid.toml"
@@ -172,11 +173,18 @@ def test_truth_rows_and_features_in_the_authors_format(dataset):
     rows = list(csv.DictReader((out / "frames.csv").open()))
     assert len(rows) == counts["images"]
     assert {r["case"] for r in rows} == {"5", "6"}  # perpendicular right, left
+    # The intent labels (sim.world.intent): a time exactly when something happens.
+    assert {r["intent"] for r in rows} <= {i.value for i in Intent}
+    assert all((r["intent_time"] == "") == (r["intent"] == "keep going") for r in rows)
+    assert {r["case_now"] for r in rows} <= {str(c) for c in range(1, 10)}
     runs = list(csv.DictReader((out / "runs.csv").open()))
     assert [r["run"] for r in runs] == [r.id for r in expand(load_spec(dataset[0]))]
     for path in sorted((out / "features").rglob("*.csv")):
         log = read_log(path)  # the authors' log reader accepts it
         assert len(log) >= 5
+        feats = list(csv.DictReader(path.open()))
+        assert sum(r["phiRate"] != "" for r in feats) >= len(feats) - 2  # from the 4th frame
+        assert all(r["groundSpeed"] == "" or float(r["groundSpeed"]) >= 0 for r in feats)
     card = (out / "README.md").read_text()
     assert "## Licence" in card and "CC-BY-4.0" in card and f"| runs | {counts['runs']} |" in card
 
