@@ -22,12 +22,11 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from tqdm import tqdm
-
 from monopic.errors import UserError
 from sim.runs.aeb import AebParams, run_aeb
 from sim.runs.code_version import code_version
 from sim.runs.results_file import ResultsWriter, read_rows, scan
+from sim.runs.sweep import run_missing, say_skipped
 from sim.scenario.files import load
 from sim.scenario.ncap import (
     KMH,
@@ -191,26 +190,10 @@ def run_grid(
     with ResultsWriter(out) as writer:
         todo = [r for r in runs if r.id not in writer.state.ids]
         skipped = len(runs) - len(todo)
-        if skipped and progress:
-            print(f"{out}: {skipped} of {len(runs)} runs already there, running the other "
-                  f"{len(todo)}", file=sys.stderr)  # fmt: skip
-        failed: list[tuple[str, str]] = []
-        finished = 0
         start = time.perf_counter()
-        with tqdm(total=len(todo), unit="run", desc="ncap", disable=not progress) as bar:
-
-            def on_result(row: dict[str, Any]) -> None:
-                nonlocal finished
-                if "error" in row:
-                    failed.append((row["id"], row["error"]))
-                    bar.write(f"run {row['id']} failed: {row['error'].strip().splitlines()[-1]}")
-                else:
-                    writer.append(row)
-                    finished += 1
-                bar.update(1)
-
-            if todo:
-                executor(todo, on_result)
+        if skipped and progress:
+            say_skipped(out, skipped, len(runs), len(todo))
+        finished, failed = run_missing(todo, executor, writer, "ncap", progress)
     return GridOutcome(len(runs), skipped, finished, tuple(failed), time.perf_counter() - start)
 
 

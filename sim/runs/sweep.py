@@ -310,27 +310,42 @@ def run_sweep(
         skipped = len(runs) - len(todo)
         if limit is not None:
             todo = todo[:limit]
-        failed: list[tuple[str, str]] = []
-        finished = 0
         start = time.perf_counter()
         if skipped and progress:
-            print(f"{out}: {skipped} of {len(runs)} runs already there, running the other "
-                  f"{len(todo)}", file=sys.stderr)  # fmt: skip
-        bar = tqdm(
-            total=len(todo), unit="run", desc=spec.name, disable=not progress, dynamic_ncols=True
-        )
-        with bar:
-
-            def on_result(row: dict[str, Any]) -> None:
-                nonlocal finished
-                if "error" in row:
-                    failed.append((row["id"], row["error"]))
-                    bar.write(f"run {row['id']} failed: {row['error'].strip().splitlines()[-1]}")
-                else:
-                    writer.append(row)
-                    finished += 1
-                bar.update(1)
-
-            if todo:
-                executor(todo, on_result)
+            say_skipped(out, skipped, len(runs), len(todo))
+        finished, failed = run_missing(todo, executor, writer, spec.name, progress)
     return SweepOutcome(len(runs), skipped, finished, tuple(failed), time.perf_counter() - start)
+
+
+def say_skipped(out: Path, skipped: int, total: int, todo: int) -> None:
+    """The resume line: what a rerun finds already done."""
+    print(f"{out}: {skipped} of {total} runs already there, running the other {todo}",
+          file=sys.stderr)  # fmt: skip
+
+
+def run_missing(
+    todo: Sequence[Any], executor: Executor, writer: ResultsWriter, desc: str, progress: bool
+) -> tuple[int, list[tuple[str, str]]]:
+    """Run `todo` on `executor`, appending each result line to `writer` as it arrives (a
+    crash loses no finished run) and naming each failure above the progress bar; returns
+    how many finished and the failures (id, error). The sweep and the Euro NCAP grid both
+    run their runs through here."""
+    failed: list[tuple[str, str]] = []
+    finished = 0
+    with tqdm(
+        total=len(todo), unit="run", desc=desc, disable=not progress, dynamic_ncols=True
+    ) as bar:
+
+        def on_result(row: dict[str, Any]) -> None:
+            nonlocal finished
+            if "error" in row:
+                failed.append((row["id"], row["error"]))
+                bar.write(f"run {row['id']} failed: {row['error'].strip().splitlines()[-1]}")
+            else:
+                writer.append(row)
+                finished += 1
+            bar.update(1)
+
+        if todo:
+            executor(list(todo), on_result)
+    return finished, failed
