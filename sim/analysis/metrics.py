@@ -86,7 +86,14 @@ def methods(rows: Iterable[RunResult]) -> list[str]:
     return sorted(found, key=_method_order)
 
 
-_ORDER = {"image": 0, "ground": 1, "rules": 0, "tree": 1, "constant-velocity": 2}
+_ORDER = {
+    "image": 0,
+    "ground": 1,
+    "rules": 0,
+    "tree": 1,
+    "constant-velocity": 2,
+    "intent-tree": 3,
+}
 
 
 def _method_order(method: str) -> tuple[int, int, int, str]:

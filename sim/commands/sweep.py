@@ -189,6 +189,8 @@ def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
         families.setdefault(r.family, []).append(r)
     print(f"{spec.path}: {len(runs)} runs in {len(families)} families, {already} already in "
           f"{out}, {len(todo)} to run{limit}")  # fmt: skip
+    if spec.intent_tree is not None:
+        print(f"  also predictor intent-tree/ground with {spec.intent_tree}")
     width = max(len("family"), *(len(f) for f in families))
     print(f"  {'family':<{width}}  {'kind':<9}  {'scale':<5}  runs  to run  frames (at most)")
     for family, members in sorted(families.items()):
