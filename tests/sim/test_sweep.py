@@ -380,3 +380,27 @@ def test_a_bad_intent_tree_key_is_one_line(
     assert main(["sweep", str(spec_file), "--dry-run"]) == 2
     err = capsys.readouterr().err.strip()
     assert "\n" not in err and str(spec_file) in err and expected in err, err
+
+
+def test_the_judged_intent_sweep_shares_no_run_or_seed_with_the_training_data() -> None:
+    """intent-judged draws other seeds and values outside intent-train's ranges."""
+    import tomllib
+
+    from sim.runs.sweep import expand_spec, load_spec, parse_spec
+    from tests.paths import SCENARIOS
+
+    train = expand_spec(load_spec(SCENARIOS / "datasets" / "intent-train.toml"))
+    judged_path = SCENARIOS / "sweeps" / "intent-judged.toml"
+    data = tomllib.loads(judged_path.read_text())
+    assert data.pop("intent_tree") == "../../recordings/intent/ground.json"
+    judged = expand_spec(parse_spec(judged_path, data))  # the tree file is made later
+    assert {r.family for r in judged} == {r.family for r in train}
+    assert not {(r.family, r.scenario.seed) for r in train} & {
+        (r.family, r.scenario.seed) for r in judged
+    }
+    for key in ("scene.road.lane_width", "pedestrian.speed", "pedestrian.behaviour.stop_lead"):
+        top = max(r.params[key] for r in train)
+        assert min(r.params[key] for r in judged) > top, key
+    assert max(r.params["pedestrian.behaviour.head_check_probability"] for r in judged) < min(
+        r.params["pedestrian.behaviour.head_check_probability"] for r in train
+    )
