@@ -10,9 +10,6 @@ from monopic.errors import UserError
 from monopic.output import write_text_atomically
 from monopic.predict.base import Mode
 from monopic.replay.dataset import prepare
-from monopic.replay.intent_training import (
-    DEFAULT_MIN_SAMPLES as INTENT_MIN_SAMPLES,
-)
 from monopic.replay.intent_training import read_dataset, split_runs, train_intent_tree
 from monopic.replay.judge import (
     VELOCITY_WINDOW_S,
@@ -254,10 +251,7 @@ def _train_ground(args: argparse.Namespace) -> int:
             f"run {dup!r} is in two datasets given (it could be trained on and validated)"
         )
     split = split_runs(runs, args.validation_share, args.validate_family, args.exclude_family)
-    min_samples = (
-        args.min_samples if args.min_samples != DEFAULT_MIN_SAMPLES else INTENT_MIN_SAMPLES
-    )
-    result = train_intent_tree(runs, split, min_samples=min_samples, sources=sources)
+    result = train_intent_tree(runs, split, min_samples=args.min_samples, sources=sources)
     out = output_file(args.out, "--out")
     save_model(result.model, out)
     print(result.report)

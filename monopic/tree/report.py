@@ -144,7 +144,7 @@ def intent_summary(model: IntentTreeModel) -> str:
         f"{model.discretiser.name}, depth {model.tree.depth}, "
         f"{sum(1 for n in model.tree.nodes() if n.is_leaf)} leaves; labels case/intent, "
         "leaves correct constant velocity (m, forward/left)",
-        f"Chosen on validation: {chosen or 'unknown'}; trained on "
+        f"Chosen on validation: {_chosen_text(chosen)}; trained on "
         f"{len(split.get('train', []))} runs, validated on {len(split.get('validation', []))}"
         f", excluded {len(split.get('excluded', []))}",
         _validation_text(val),
@@ -174,3 +174,9 @@ def _validation_text(val: dict) -> str:
         f"{val['constant_velocity_median_error_m']:.3f} m); warnings {val['warnings']} "
         f"(constant velocity: {val['constant_velocity_warnings']})"
     )
+
+
+def _chosen_text(chosen: dict) -> str:
+    if not chosen:
+        return "unknown"
+    return f"{chosen['binning']} bins, depth {chosen['max_depth']}"
