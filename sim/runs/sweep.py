@@ -262,6 +262,18 @@ def set_aside(out: Path, folder: Path, tag: str) -> None:
         print(f"set aside: {source} -> {target}", file=sys.stderr)
 
 
+def sweep_code(spec: SweepSpec) -> str:
+    """The code version its results carry: with an intent tree, the tree file's digest too.
+
+    So a results file made with one tree is not resumed with another (it is "other code").
+    """
+    code = code_version()
+    if spec.intent_tree is None:
+        return code
+    digest = hashlib.sha256(spec.intent_tree.read_bytes()).hexdigest()[:8]
+    return f"{code}+tree-{digest}"
+
+
 def run_sweep(
     spec: SweepSpec,
     out: Path,
@@ -281,7 +293,7 @@ def run_sweep(
     A results file holding runs of other code (sim.runs.code_version) is not resumed: that
     is an error, or with `restart` the file and its recordings are set aside first.
     """
-    code = code_version()
+    code = sweep_code(spec)
     runs = expand_spec(spec)
     if ablation is not None:
         runs = [replace(r, ablation=ablation) for r in runs]

@@ -356,6 +356,16 @@ def test_a_spec_names_an_intent_tree_relative_to_itself_and_runs_it_last(tmp_pat
     assert [f"{p.name}/{p.mode}" for p in plain.predictors] == keys
     assert [f"{p.name}/{p.mode}" for p in with_tree.predictors] == [*keys, "intent-tree/ground"]
     assert with_tree.primary == plain.primary
+    # Results carry the tree's digest in their code version: another tree is other code.
+    from sim.runs.code_version import code_version
+    from sim.runs.sweep import sweep_code
+
+    first = sweep_code(spec)
+    assert first.startswith(code_version() + "+tree-")
+    tree.write_text(tree.read_text().replace('"min_rows": 20', '"min_rows": 21'))
+    assert sweep_code(load_spec(spec_file)) not in (first, code_version())
+    (tmp_path / "plain.toml").write_text(SPEC.format(ablation="false"))
+    assert sweep_code(load_spec(tmp_path / "plain.toml")) == code_version()
 
 
 @pytest.mark.parametrize(
