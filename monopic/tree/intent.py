@@ -318,13 +318,14 @@ def place(
                 arithmetic += 2  # (py - y) * toward
                 if toward == 0.0 or c.lt(0.0, (py - y) * toward):
                     py, action = y, Action.HOLD_TURN
-        elif is_start and not c.lt(reading.support, rules.warn_support) and toward != 0.0:
-            c.comparisons += 1  # toward != 0
-            reach = rules.start_speed * horizon
-            arithmetic += 3  # reach; (py - y) * toward
-            if c.lt((py - y) * toward, reach):
-                py, action = y + toward * reach, Action.EARLIER
-                arithmetic += 2
+        elif is_start and not c.lt(reading.support, rules.warn_support):
+            c.comparisons += 1  # toward != 0: on the centre line there is no "toward"
+            if toward != 0.0:
+                reach = rules.start_speed * horizon
+                arithmetic += 3  # reach; (py - y) * toward
+                if c.lt((py - y) * toward, reach):
+                    py, action = y + toward * reach, Action.EARLIER
+                    arithmetic += 2
     ops = c.ops + Ops(arithmetic=arithmetic)
     return (px, py), action, ops
 

@@ -239,6 +239,13 @@ def test_turn_away_drops_the_motion_toward_the_path_and_start_crossing_adds_it()
     assert start.action is Action.EARLIER and start.point == pytest.approx((3.0, 0.5))
     off = IntentTreePredictor(leaf_model("9/start crossing", 10, IntentRules(min_rows=5)))
     assert off.decide(g, 1.0).point == pytest.approx((3.0, 1.5))
+    # On the centre line there is no "toward": start crossing adds nothing, turn away
+    # drops all lateral motion (any of it counts as away, as the labels say).
+    centre = ground_features(standing, (3.0, 0.0))
+    on_line = IntentTreePredictor(leaf_model("9/start crossing", 10, on)).decide(centre, 1.0)
+    assert on_line.action is Action.NONE and on_line.point == pytest.approx((3.0, 0.0))
+    walking = ground_features(WALK_IN, (3.0, 0.0))
+    assert turn.decide(walking, 1.0).point == pytest.approx((3.5, 0.0))
 
 
 def test_operation_counts_are_counted_as_run_and_bounded_by_the_worst_case() -> None:
