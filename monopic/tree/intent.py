@@ -26,7 +26,7 @@ from __future__ import annotations
 import math
 from collections import Counter
 from collections.abc import Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from enum import StrEnum
 from typing import Any
 
@@ -359,7 +359,8 @@ class IntentTreePredictor:
 
     def predict(self, features: Features, horizon: float) -> Prediction:
         d = self.decide(features, horizon)
-        return with_ground_point(features, d.reading.case, horizon, d.point)
+        p = with_ground_point(features, d.reading.case, horizon, d.point)
+        return replace(p, intent=d.reading.intent)
 
 
 def worst_case_ops(model: IntentTreeModel) -> Ops:

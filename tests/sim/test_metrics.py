@@ -277,3 +277,25 @@ def test_two_sweeps_beside_each_other_cell_by_cell(tmp_path: Path) -> None:
     assert fam[("f2", KEY)][3] == "- / 1"  # a family only the other sweep holds
     report = write_report(rail, [], tmp_path / "rail.jsonl", tmp_path / "rep", ("human", human))
     assert "## Beside human" in report.markdown.read_text()
+
+
+def test_frames_before_a_change_of_intent_are_the_last_1_5_s_before_it() -> None:
+    from sim.analysis.metrics import before_change
+
+    times = [k * 0.5 for k in range(8)]  # 0 .. 3.5 s
+    labels = ["keep going"] * 5 + ["stop"] * 3  # changes at 2.5 s
+    assert before_change(times, labels) == [False, False, True, True, True, False, False, False]
+    assert not any(before_change(times, ["keep going"] * 8))
+    with_gap = [*labels[:4], None, *labels[5:]]  # an unknown label is no change
+    assert not any(before_change(times, with_gap))
+
+
+def test_intent_accuracy_counts_decided_frames_and_those_before_a_change() -> None:
+    from sim.analysis.metrics import Accuracy, _accuracy
+
+    said = ["stop", None, "keep going", "stop"]
+    truth = ["stop", "stop", "stop", "stop"]
+    near = [True, True, False, True]
+    got = _accuracy(said, truth, near)
+    assert got == Accuracy(frames=3, correct=2, before_frames=2, before_correct=2)
+    assert got.accuracy == 2 / 3 and got.before_accuracy == 1.0
