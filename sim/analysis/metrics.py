@@ -500,25 +500,58 @@ class IntentSummary:
     intent: Accuracy
     case: Accuracy
     baseline_case: Accuracy  # truth.case_now (the case of the velocity now) as the answer
+    # Frames where its ground point and constant velocity's (same pipeline) are both known
+    # against the truth, those where they differ by more than DIFFERS_M, and the median
+    # error (m) of each on the differing frames.
+    compared: int = 0
+    differing: int = 0
+    error_m: float = math.nan
+    cv_error_m: float = math.nan
+
+    @property
+    def differing_share(self) -> float:
+        return ratio(self.differing, self.compared)
+
+
+DIFFERS_M = 0.05  # m: closer than this, the two points are the same prediction
 
 
 def intent_summary(rows: Sequence[RunResult], method: str) -> IntentSummary | None:
     """None when the method states no intent or the lines carry no intent labels."""
     intent = case = baseline = Accuracy()
     seen = False
+    pipeline, key = split_method(method)
+    cv_method = method_name(pipeline, f"constant-velocity/{key.partition('/')[2]}")
+    compared, errors, cv_errors = 0, [], []
     for row in rows:
         cols = _decisions(row, method)
         truth = row.truth
         if not cols or not cols.intent or not truth.intent:
             continue
         seen = True
+        cv = _decisions(row, cv_method)
+        for k, future in enumerate(truth.future if cv else ()):
+            mine, theirs = cols.ground[k], cv.ground[k] if cv else None
+            if mine is None or theirs is None or future is None:
+                continue
+            if None in mine + theirs + future:
+                continue
+            compared += 1
+            if math.dist(mine, theirs) > DIFFERS_M:
+                errors.append(math.dist(mine, future))
+                cv_errors.append(math.dist(theirs, future))
         near = before_change(truth.t, truth.intent)
         decided = [w is not None for w in cols.warn]
         intent = intent + _accuracy(cols.intent, truth.intent, near)
         case = case + _accuracy(cols.case, truth.case, near)
         now = [c if d else None for c, d in zip(truth.case_now, decided, strict=True)]
         baseline = baseline + _accuracy(now, truth.case, near)
-    return IntentSummary(method, intent, case, baseline) if seen else None
+    if not seen:
+        return None
+    median = lambda v: float(np.median(v)) if v else math.nan  # noqa: E731
+    return IntentSummary(
+        method, intent, case, baseline, compared, len(errors), median(errors), median(cv_errors)
+    )
 
 
 @dataclass(frozen=True)

@@ -457,12 +457,16 @@ def _intent_table(m: SweepMetrics) -> list[str]:
                 pct(s.baseline_case.accuracy),
                 pct(s.baseline_case.before_accuracy),
                 str(s.intent.before_frames),
+                pct(s.differing_share),
+                f"{num(s.error_m)} / {num(s.cv_error_m)}",
             ]
         )
     return [
         "Intent (predictors that state one): accuracy on the frames they decided, and on "
         "those in the 1.5 s before a change of the true intent; the baseline answers the "
-        "case of the true velocity now on the same frames.",
+        "case of the true velocity now on the same frames. 'differs': the share of frames "
+        "where its ground point is more than 5 cm from constant velocity's, and the median "
+        "error (m) of each on those frames (it / constant velocity).",
         "",
         *table(
             [
@@ -475,6 +479,8 @@ def _intent_table(m: SweepMetrics) -> list[str]:
                 "baseline case acc.",
                 "before change",
                 "frames before",
+                "differs",
+                "m err there",
             ],
             rows,
         ),  # fmt: skip

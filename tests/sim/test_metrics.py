@@ -299,3 +299,45 @@ def test_intent_accuracy_counts_decided_frames_and_those_before_a_change() -> No
     got = _accuracy(said, truth, near)
     assert got == Accuracy(frames=3, correct=2, before_frames=2, before_correct=2)
     assert got.accuracy == 2 / 3 and got.before_accuracy == 1.0
+
+
+def test_intent_summary_against_the_truth_and_constant_velocity() -> None:
+    """Hand-made columns: the tree states intents; where its point leaves constant
+    velocity's, the errors of both are reported there."""
+    import dataclasses
+
+    from sim.analysis.metrics import intent_summary
+    from sim.runs.result import DecisionColumns
+
+    n = 6
+    base = row("r", [None] * n, [0] * n)
+    truth = dataclasses.replace(
+        base.truth,
+        intent=["keep going"] * 3 + ["stop"] * 3,  # changes at 0.3 s
+        case_now=[5, 5, 5, 9, 9, 9],
+        case=[5, 5, 9, 9, 9, 9],
+    )
+    tree = DecisionColumns(
+        warn=[0] * n,
+        case=[5, 5, 9, 9, 9, 5],
+        foot=[None] * n,
+        ground=[[1.0, 0.0], [1.0, 0.0], [1.0, 0.0], [1.0, 0.0], [1.5, 0.0], [1.0, 0.0]],
+        ttc=[None] * n,
+        intent=["keep going", "stop", "stop", "stop", "stop", "keep going"],
+    )
+    cv = DecisionColumns(
+        warn=[0] * n, case=[5] * n, foot=[None] * n, ground=[[1.0, 0.0]] * n, ttc=[None] * n
+    )
+    main = dataclasses.replace(
+        base.pipelines["main"],
+        decisions={"intent-tree/ground": tree, "constant-velocity/ground": cv},
+    )
+    r = dataclasses.replace(base, truth=truth, pipelines={"main": main})
+    s = intent_summary([r], "intent-tree/ground")
+    assert s is not None
+    assert (s.intent.frames, s.intent.correct) == (6, 3)  # frames 1, 2 and 5 wrong
+    assert (s.intent.before_frames, s.intent.before_correct) == (3, 1)  # frames 0-2
+    assert (s.case.correct, s.baseline_case.correct) == (5, 5)
+    assert (s.compared, s.differing) == (6, 1)  # frame 4: 0.5 m from constant velocity
+    assert s.error_m == 0.5 and s.cv_error_m == 0.0  # the truth's future is (1, 0)
+    assert intent_summary([r], "constant-velocity/ground") is None  # states no intent
