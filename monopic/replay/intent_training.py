@@ -21,7 +21,7 @@ import json
 import math
 import zlib
 from collections.abc import Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +41,7 @@ from monopic.tree.intent import (
     fit_intent_model,
     joint_label,
     place,
+    shrink_corrections,
 )
 from monopic.variants.zone import RobotGeometry, meets_swept_footprint
 
@@ -61,6 +62,7 @@ POSITION_COLUMNS = ("groundX", "groundY")
 TRUTH_KEYS = ("frame", "time", "case", "intent", "future_position_robot", "collision", "robot")
 BINNINGS = ("mdl", "q2", "q3", "q4")
 DEPTHS = (1, 2, 3, 4, 6)
+SHRINKS: tuple[float | None, ...] = (0.0, 20.0, 100.0, None)  # None: constant velocity's point
 SUPPORTS = (0.5, 0.6, 0.7, 0.8, 0.9, 1.01)  # 1.01: the rule off
 START_SPEEDS = (0.6, 1.0, 1.4)
 DEFAULT_MIN_SAMPLES = 20
@@ -287,13 +289,18 @@ def split_runs(
 
 @dataclass(frozen=True)
 class Candidate:
-    """One way to bin and grow the tree."""
+    """One way to bin and grow the tree, and how far its corrections are shrunk."""
 
     binning: str
     max_depth: int
+    shrink: float | None = 0.0  # rows (n / (n + shrink)); None: corrections off
 
     def describe(self) -> str:
-        return f"{self.binning}, depth {self.max_depth}"
+        return f"{self.binning}, depth {self.max_depth}, {_shrink_text(self.shrink)}"
+
+
+def _shrink_text(shrink: float | None) -> str:
+    return "no correction" if shrink is None else f"shrink {shrink:g}"
 
 
 def quantile_cuts(values: Sequence[float], bins: int) -> tuple[float, ...]:
@@ -391,6 +398,7 @@ def train_intent_tree(
     min_samples: int = DEFAULT_MIN_SAMPLES,
     binnings: Sequence[str] = BINNINGS,
     depths: Sequence[int] = DEPTHS,
+    shrinks: Sequence[float | None] = SHRINKS,
     supports: Sequence[float] = SUPPORTS,
     start_speeds: Sequence[float] = START_SPEEDS,
     min_rows: int = DEFAULT_MIN_SAMPLES,
@@ -413,13 +421,21 @@ def train_intent_tree(
     for binning in binnings:
         disc = make_discretiser(binning, train)
         for depth in depths:
-            cand = Candidate(binning, depth)
-            model = fit_intent_model(train, disc, ID3Params(min_samples, depth), horizon, off)
-            err = float(np.median([point_error(model, s, off) for s in val]))
-            scored.append((cand, err, model))
-    # Lowest validation median error; ties (1 mm) to the shallower, then the listed binning.
+            fitted = fit_intent_model(train, disc, ID3Params(min_samples, depth), horizon, off)
+            for shrink in shrinks:
+                model = replace(fitted, tree=shrink_corrections(fitted.tree, shrink))
+                err = float(np.median([point_error(model, s, off) for s in val]))
+                scored.append((Candidate(binning, depth, shrink), err, model))
+    # Lowest validation median error; ties (1 mm) to the shallower, the listed binning,
+    # then the more shrunk corrections.
     best_cand, best_err, best = min(
-        scored, key=lambda c: (round(c[1], 3), c[0].max_depth, binnings.index(c[0].binning))
+        scored,
+        key=lambda c: (
+            round(c[1], 3),
+            c[0].max_depth,
+            binnings.index(c[0].binning),
+            -list(shrinks).index(c[0].shrink),
+        ),
     )
     readings = [
         LeafReading.of(best.tree.answer(best.discretiser.discretise(s.values))) for s in val
@@ -479,7 +495,11 @@ def train_intent_tree(
             "validation": [r.run for r in split.validation],
             "excluded": [r.run for r in split.excluded],
         },
-        "chosen": {"binning": best_cand.binning, "max_depth": best_cand.max_depth},
+        "chosen": {
+            "binning": best_cand.binning,
+            "max_depth": best_cand.max_depth,
+            "shrink_rows": best_cand.shrink,  # null: corrections off
+        },
         "validation": {
             "median_error_m": best_err,
             "constant_velocity_median_error_m": cv_median,
@@ -496,8 +516,16 @@ def train_intent_tree(
         best.root_gains,
         provenance,
     )
-    table = ["Candidates (median error of the tree's point on validation, m):"]
-    table += [f"  {c.describe():<16} {e:.3f}" for c, e, _ in scored]
+    heads = "  ".join(f"{_shrink_text(x):>13}" for x in shrinks)
+    table = [
+        "Candidates (median error of the tree's point on validation, m):",
+        f"  {'bins, depth':<12} {heads}",
+    ]
+    for binning in binnings:
+        for depth in depths:
+            errs = [e for c, e, _ in scored if (c.binning, c.max_depth) == (binning, depth)]
+            cells = "  ".join(f"{e:>13.3f}" for e in errs)
+            table.append(f"  {f'{binning}, {depth}':<12} {cells}")
     table.append(f"  constant velocity {cv_median:.3f}")
     table.append(f"Chosen: {best_cand.describe()} ({best_err:.3f} m)")
     table.append(

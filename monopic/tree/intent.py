@@ -192,15 +192,7 @@ class IntentTreeModel:
                 raise ValueError(f"node correction {node.mean!r} is not a (forward, left) pair")
 
     def with_rules(self, rules: IntentRules) -> IntentTreeModel:
-        return IntentTreeModel(
-            self.horizon,
-            self.discretiser,
-            self.tree,
-            rules,
-            self.root_entropy,
-            self.root_gains,
-            self.provenance,
-        )
+        return replace(self, rules=rules)
 
 
 def fit_intent_model(
@@ -230,6 +222,28 @@ def fit_intent_model(
         root_gains=gains,
         provenance=dict(provenance or {}),
     )
+
+
+def shrink_corrections(tree: DecisionTree, shrink: float | None) -> DecisionTree:
+    """Every node's correction times n / (n + shrink); None: all corrections zero.
+
+    Why: on little data a leaf's mean correction is mostly noise; pulling it toward 0
+    (constant velocity) by its row count keeps what many rows agree on. The intent
+    counts, and so the rules, are unchanged.
+    """
+    if shrink is not None and not (math.isfinite(shrink) and shrink >= 0):
+        raise ValueError(f"shrink must be a finite number >= 0 or None, got {shrink}")
+
+    def walk(node: Node) -> Node:
+        assert node.mean is not None
+        k = 0.0 if shrink is None else node.n / (node.n + shrink)
+        return replace(
+            node,
+            mean=tuple(m * k for m in node.mean),
+            branches=tuple((v, walk(child)) for v, child in node.branches),
+        )
+
+    return DecisionTree(tree.attributes, walk(tree.root))
 
 
 @dataclass(frozen=True)

@@ -179,4 +179,6 @@ def _validation_text(val: dict) -> str:
 def _chosen_text(chosen: dict) -> str:
     if not chosen:
         return "unknown"
-    return f"{chosen['binning']} bins, depth {chosen['max_depth']}"
+    shrink = chosen.get("shrink_rows", 0.0)
+    corrections = "corrections off" if shrink is None else f"corrections shrunk by {shrink:g} rows"
+    return f"{chosen['binning']} bins, depth {chosen['max_depth']}, {corrections}"

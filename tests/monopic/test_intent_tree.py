@@ -333,3 +333,16 @@ def test_bad_input_is_one_line_naming_file_and_field(
     assert main([*_train(dataset, tmp_path), "--leaf-value", "velocity-gain"]) == 2
     assert "--leaf-value: image mode only" in one_line_error(capsys)
     assert not (tmp_path / "t.json").exists()
+
+
+def test_corrections_shrink_toward_constant_velocity_by_row_count() -> None:
+    from monopic.tree.intent import LeafReading, shrink_corrections
+
+    tree = leaf_model("6/stop", 30, IntentRules(), mean=(1.0, -2.0)).tree
+    half = shrink_corrections(tree, 30.0)
+    assert half.root.mean == pytest.approx((0.5, -1.0))
+    assert shrink_corrections(tree, None).root.mean == (0.0, 0.0)
+    assert shrink_corrections(tree, 0.0) == tree
+    assert LeafReading.of(half.root).intent == "stop"  # the rules read the same counts
+    with pytest.raises(ValueError, match="shrink"):
+        shrink_corrections(tree, -1.0)
