@@ -149,8 +149,11 @@ def test_sweep_writes_one_line_per_run_and_resumes_without_loss(
     assert set(record.pipelines) == {"main", "gtcrop"}
     n = record.frames
     assert len(record.truth.t) == n
+    assert len(record.truth.intent) == len(record.truth.case_now) == n
     for cols in record.pipelines["main"].decisions.values():
-        assert all(len(v) == n for v in vars(cols).values())
+        # The intent column is kept only by predictors stating one (none run here).
+        assert cols.intent == []
+        assert all(len(v) == n for k, v in vars(cols).items() if k != "intent")
 
     # Runs that went wrong (missed collision, false alarm) keep a recording, the others not.
     recorded = sorted(r["recording"] for r in read_rows(out) if r["recording"])
