@@ -8,7 +8,9 @@ from pathlib import Path
 from monopic.cli.args import non_negative_float, output_file, positive_float, positive_int
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
+from monopic.predict.base import Mode
 from monopic.replay.dataset import prepare
+from monopic.replay.intent_training import read_dataset, split_runs, train_intent_tree
 from monopic.replay.judge import (
     VELOCITY_WINDOW_S,
     candidate_grid,
@@ -24,8 +26,9 @@ from monopic.replay.training import (
     train_on_logs,
 )
 from monopic.tree.discretise import AUTHORS_DEAD_ZONE
-from monopic.tree.report import summary, tree_dot
-from monopic.tree.serialise import load_default_model, load_model, save_model
+from monopic.tree.intent import IntentTreeModel
+from monopic.tree.report import intent_summary, intent_tree_dot, summary, tree_dot
+from monopic.tree.serialise import load_any_model, load_default_model, save_model
 
 JUDGE_DESCRIPTION = """\
 Judge the image-mode tree at the real 1 s horizon, leave one file out: for each log, a
@@ -113,13 +116,51 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
     t = sub.add_parser(
         "train",
-        help="fit a tree on logs in the authors' CSV format",
-        description="Fit an image-mode ID3 tree on the scored rows of the logs (rows after "
-        "the 0.5 s warm-up with a full next second), labelled with the case of the next "
-        "second of motion; print the gain table and the tree; write versioned JSON.",
+        help="fit a tree on logs in the authors' CSV format, or a ground tree on datasets",
+        description="Image mode (default): fit an ID3 tree on the scored rows of the logs "
+        "(rows after the 0.5 s warm-up with a full next second), labelled with the case of "
+        "the next second of motion; print the gain table and the tree; write versioned "
+        "JSON. Ground mode (--mode ground): DATA are dataset folders (`monopic dataset`); "
+        "fit the intent tree (labels case/intent, leaves correcting constant velocity) on "
+        "the pipeline's features joined to the truth, its bins, depth and intent rules "
+        "chosen on a validation split by (family, seed) that it prints; the predictor "
+        "`intent-tree` reads the file (docs/intent/ground-tree.md).",
     )
     t.add_argument(
-        "data", nargs="+", type=Path, metavar="DATA.csv", help="logs in the authors' CSV format"
+        "data",
+        nargs="+",
+        type=Path,
+        metavar="DATA",
+        help="image mode: logs in the authors' CSV format; ground mode: dataset folders",
+    )
+    t.add_argument(
+        "--mode",
+        choices=[m.value for m in Mode],
+        default=Mode.IMAGE.value,
+        help="image: the paper's tree on authors' logs (default); ground: the intent tree "
+        "on datasets",
+    )
+    t.add_argument(
+        "--validation-share",
+        type=positive_float,
+        default=0.25,
+        metavar="F",
+        help="ground mode: share of (family, seed) groups validated on, by a fixed hash "
+        "(default %(default)g)",
+    )
+    t.add_argument(
+        "--validate-family",
+        action="append",
+        default=[],
+        metavar="FAMILY",
+        help="ground mode: validate on this family (repeatable; instead of the hash share)",
+    )
+    t.add_argument(
+        "--exclude-family",
+        action="append",
+        default=[],
+        metavar="FAMILY",
+        help="ground mode: leave this family out entirely, e.g. a judged one (repeatable)",
     )
     t.add_argument(
         "--out", required=True, type=Path, metavar="TREE.json", help="the tree file to write"
@@ -160,6 +201,8 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 
 
 def _train(args: argparse.Namespace) -> int:
+    if args.mode == Mode.GROUND.value:
+        return _train_ground(args)
     logs = [prepare(read_log(path), velocity_window=args.velocity_window) for path in args.data]
     try:
         model = train_on_logs(logs, training_options(args))
@@ -168,6 +211,52 @@ def _train(args: argparse.Namespace) -> int:
     out = output_file(args.out, "--out")
     save_model(model, out)
     print(summary(model))
+    print(f"\nwrote {out}")
+    return 0
+
+
+IMAGE_ONLY = (
+    ("discretiser", "--discretiser", "authors"),
+    ("dead_zone", "--dead-zone", AUTHORS_DEAD_ZONE),
+    ("leaf_value", "--leaf-value", LEAF_VALUES[0]),
+    ("velocity_window", "--velocity-window", None),
+    ("max_depth", "--max-depth", None),
+)
+
+
+def _train_ground(args: argparse.Namespace) -> int:
+    """The intent tree on dataset folders (options chosen on validation, not given)."""
+    for attr, option, default in IMAGE_ONLY:
+        if getattr(args, attr) != default:
+            raise UserError(
+                f"{option}: image mode only (ground mode chooses its bins and depth on "
+                "the validation split)"
+            )
+    if not 0 < args.validation_share < 1:
+        raise UserError(f"--validation-share {args.validation_share:g}: must be below 1")
+    runs = []
+    sources = []
+    for folder in args.data:
+        if not folder.is_dir():
+            raise UserError(
+                f"{folder}: not a dataset folder (ground mode reads `monopic dataset` output)"
+            )
+        got = read_dataset(folder)
+        runs.extend(got)
+        sources.append({"folder": str(folder), "runs": len(got)})
+    ids = [r.run for r in runs]
+    dup = next((i for n, i in enumerate(ids) if i in ids[:n]), None)
+    if dup is not None:
+        raise UserError(
+            f"run {dup!r} is in two datasets given (it could be trained on and validated)"
+        )
+    split = split_runs(runs, args.validation_share, args.validate_family, args.exclude_family)
+    result = train_intent_tree(runs, split, min_samples=args.min_samples, sources=sources)
+    out = output_file(args.out, "--out")
+    save_model(result.model, out)
+    print(result.report)
+    print()
+    print(intent_summary(result.model))
     print(f"\nwrote {out}")
     return 0
 
@@ -199,6 +288,12 @@ def _judge(args: argparse.Namespace) -> int:
 
 
 def _show(args: argparse.Namespace) -> int:
-    model = load_model(args.tree)
+    model = load_any_model(args.tree)
+    if isinstance(model, IntentTreeModel):
+        print(
+            intent_tree_dot(model) if args.dot else intent_summary(model),
+            end="" if args.dot else "\n",
+        )
+        return 0
     print(tree_dot(model) if args.dot else summary(model), end="" if args.dot else "\n")
     return 0

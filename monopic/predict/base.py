@@ -37,6 +37,9 @@ class Prediction:
     center: Point  # predicted centre on the image, px
     foot: Point  # predicted foot point on the image, px
     ground: Point | None = None  # predicted foot point, robot's current frame, m
+    # What the pedestrian will do within the horizon, for predictors that say (the intent
+    # tree: keep going, stop, turn away, start crossing); None for the others.
+    intent: str | None = None
 
 
 class Predictor(Protocol):

@@ -5,14 +5,15 @@ from __future__ import annotations
 from monopic.cases import Case
 from monopic.predict.base import Mode
 from monopic.tree.id3 import Node, Value, render_dot, render_text
+from monopic.tree.intent import IntentTreeModel, LeafReading, worst_case_ops
 from monopic.tree.model import LeafValue, Placement, TreeModel, TreePredictor
-from monopic.tree.opcount import ops_report
+from monopic.tree.opcount import PAPER_CALCULATIONS_PER_PREDICTION, ops_report
 
 # The paper's root information gains ("ID3 Classification"), image mode.
 PAPER_ROOT_GAINS = {"vx": 0.022, "vy": 0.014, "phi": 0.004}
 
 
-def gain_table(model: TreeModel) -> str:
+def gain_table(model: TreeModel | IntentTreeModel) -> str:
     """Root information gain per attribute, highest first, beside the paper's figures."""
     n = model.tree.root.n
     lines = [
@@ -21,7 +22,8 @@ def gain_table(model: TreeModel) -> str:
         f"  {'attribute':<10} {'ours':>7} {'paper':>7}",
     ]
     for a, g in sorted(model.root_gains, key=lambda ag: -ag[1]):
-        paper = PAPER_ROOT_GAINS.get(a) if model.mode is Mode.IMAGE else None
+        image = isinstance(model, TreeModel) and model.mode is Mode.IMAGE
+        paper = PAPER_ROOT_GAINS.get(a) if image else None
         lines.append(f"  {a:<10} {g:7.3f} {'-' if paper is None else f'{paper:.3f}':>7}")
     return "\n".join(lines)
 
@@ -93,3 +95,90 @@ def summary(model: TreeModel) -> str:
     if model.mode is Mode.IMAGE:
         parts += ["", ops_report(TreePredictor(model, Placement.LEAF))]
     return "\n".join(parts)
+
+
+def _intent_node_text(node: Node) -> str:
+    r = LeafReading.of(node)
+    text = (
+        f"case {int(r.case)} {r.case.label}, {r.intent} ({r.support:.0%} of n={r.rows}), "
+        f"corrects constant velocity by ({r.correction[0]:+.2f}, {r.correction[1]:+.2f}) m"
+    )
+    if not node.is_leaf:
+        text += f"; split on {node.attribute} (gain {node.gain:.3f})"
+    return text
+
+
+def intent_tree_text(model: IntentTreeModel) -> str:
+    return render_text(
+        model.tree,
+        describe_value=lambda a, v: f"{a} {model.discretiser.binner(a).describe(int(v))}",
+        describe_node=_intent_node_text,
+    )
+
+
+def intent_tree_dot(model: IntentTreeModel) -> str:
+    def node_label(node: Node) -> str:
+        r = LeafReading.of(node)
+        return (
+            f"case {int(r.case)}: {r.case.label}\n{r.intent} {r.support:.0%}, n={r.rows}\n"
+            f"({r.correction[0]:+.2f}, {r.correction[1]:+.2f}) m"
+        )
+
+    return render_dot(
+        model.tree,
+        describe_value=lambda a, v: f"{v}: {model.discretiser.binner(a).describe(int(v))}",
+        describe_node=node_label,
+        name="monopic-ground-intent-tree",
+    )
+
+
+def intent_summary(model: IntentTreeModel) -> str:
+    """Everything `monopic tree show` prints for a ground intent tree."""
+    r = model.rules
+    chosen = model.provenance.get("chosen", {})
+    val = model.provenance.get("validation", {})
+    split = model.provenance.get("split", {})
+    worst = worst_case_ops(model)
+    parts = [
+        f"ID3 intent tree, ground mode, horizon {model.horizon:g} s, discretiser "
+        f"{model.discretiser.name}, depth {model.tree.depth}, "
+        f"{sum(1 for n in model.tree.nodes() if n.is_leaf)} leaves; labels case/intent, "
+        "leaves correct constant velocity (m, forward/left)",
+        f"Chosen on validation: {_chosen_text(chosen)}; trained on "
+        f"{len(split.get('train', []))} runs, validated on {len(split.get('validation', []))}"
+        f", excluded {len(split.get('excluded', []))}",
+        _validation_text(val),
+        f"Intent rules: hold back at support {_support(r.hold_back_support)}, warn earlier "
+        f"at {_support(r.warn_support)}, start speed {r.start_speed:g} m/s, at least "
+        f"{r.min_rows} leaf rows",
+        "",
+        gain_table(model),
+        "",
+        intent_tree_text(model),
+        "",
+        f"Operations for one prediction (worst case over inputs): {worst.describe()}"
+        f"   [paper: {PAPER_CALCULATIONS_PER_PREDICTION} calculations per prediction]",
+    ]
+    return "\n".join(parts)
+
+
+def _support(value: float) -> str:
+    return "off" if value > 1 else f"{value:g}"
+
+
+def _validation_text(val: dict) -> str:
+    if not val:
+        return "Validation: unknown"
+    return (
+        f"Validation: median error {val['median_error_m']:.3f} m (constant velocity "
+        f"{val['constant_velocity_median_error_m']:.3f} m); warnings {val['warnings']} "
+        f"(constant velocity: {val['constant_velocity_warnings']})"
+    )
+
+
+def _chosen_text(chosen: dict) -> str:
+    if not chosen:
+        return "unknown"
+    shrink = chosen.get("shrink_rows", 0.0)
+    corrections = "corrections off" if shrink is None else f"corrections shrunk by {shrink:g} rows"
+    return f"{chosen['binning']} bins, depth {chosen['max_depth']}, {corrections}"

@@ -7,7 +7,11 @@ with another format name or version is refused with a clear message rather than 
 Version 1: leaves carry displacements. Version 2 adds "leaf_value" ("displacement" or
 "velocity-gain"); a tree with displacement leaves is still written as version 1 (so the
 shipped tree's file does not change), one with gain leaves as version 2, which a version-1
-reader refuses instead of reading gains as displacements. Both versions load.
+reader refuses instead of reading gains as displacements. Version 3 is the ground-mode
+intent tree (monopic/tree/intent.py): "leaf_value" "cv-correction", labels "case/intent",
+node means the correction to constant velocity in metres, and "intent_rules". Older
+readers refuse it by its version; `load_model` (the `tree` predictor) refuses it by name,
+`load_intent_model` reads only it. All three versions load.
 """
 
 from __future__ import annotations
@@ -23,11 +27,14 @@ from monopic.output import write_text_atomically
 from monopic.predict.base import Mode
 from monopic.tree.discretise import Discretiser
 from monopic.tree.id3 import DecisionTree
+from monopic.tree.intent import IntentRules, IntentTreeModel, IntentTreePredictor
 from monopic.tree.model import LeafValue, TreeModel, TreePredictor
 
 FORMAT = "monopic-id3-tree"
 VERSION = 2
 VERSIONS = (1, 2)
+INTENT_VERSION = 3
+INTENT_LEAF_VALUE = "cv-correction"
 DEFAULT_TREE_NAME = "default_tree.json"
 
 
@@ -51,11 +58,12 @@ def model_to_json(model: TreeModel) -> dict[str, Any]:
 
 def model_from_json(data: Any) -> TreeModel:
     """Inverse of `model_to_json`; ValueError naming what is wrong."""
-    if not isinstance(data, dict):
-        raise ValueError("not a JSON object")
-    if data.get("format") != FORMAT:
-        raise ValueError(f"format is {data.get('format')!r}, expected {FORMAT!r}")
+    _check_format(data)
     version = data.get("version")
+    if version == INTENT_VERSION:
+        raise ValueError(
+            "this is a ground intent tree (version 3): use it with predictor 'intent-tree'"
+        )
     if version not in VERSIONS:
         raise ValueError(f"version {version!r} is not supported (only {VERSIONS})")
     if version == 1 and "leaf_value" in data:
@@ -94,22 +102,106 @@ def model_from_json(data: Any) -> TreeModel:
     return model
 
 
-def dumps(model: TreeModel) -> str:
-    return json.dumps(model_to_json(model), indent=1, allow_nan=False) + "\n"
+def _check_format(data: Any) -> None:
+    if not isinstance(data, dict):
+        raise ValueError("not a JSON object")
+    if data.get("format") != FORMAT:
+        raise ValueError(f"format is {data.get('format')!r}, expected {FORMAT!r}")
 
 
-def save_model(model: TreeModel, path: Path) -> None:
+def intent_model_to_json(model: IntentTreeModel) -> dict[str, Any]:
+    return {
+        "format": FORMAT,
+        "version": INTENT_VERSION,
+        "leaf_value": INTENT_LEAF_VALUE,
+        "mode": Mode.GROUND.value,
+        "horizon_s": model.horizon,
+        "displacement_unit": "metre",
+        "labels": "case/intent",
+        "intent_rules": model.rules.to_json(),
+        "discretiser": model.discretiser.to_json(),
+        "root_entropy": model.root_entropy,
+        "root_gains": [[a, g] for a, g in model.root_gains],
+        "provenance": model.provenance,
+        "tree": model.tree.to_json(),
+    }
+
+
+def intent_model_from_json(data: Any) -> IntentTreeModel:
+    """Inverse of `intent_model_to_json`; ValueError naming what is wrong."""
+    _check_format(data)
+    version = data.get("version")
+    if version != INTENT_VERSION:
+        raise ValueError(
+            f"version {version!r} is not a ground intent tree (version {INTENT_VERSION}): "
+            "use it with predictor 'tree'"
+        )
+    for key, want in (
+        ("leaf_value", INTENT_LEAF_VALUE),
+        ("mode", Mode.GROUND.value),
+        ("displacement_unit", "metre"),
+        ("labels", "case/intent"),
+    ):
+        if data.get(key) != want:
+            raise ValueError(f"{key} is {data.get(key)!r}, expected {want!r}")
+    try:
+        return IntentTreeModel(
+            horizon=float(data["horizon_s"]),
+            discretiser=Discretiser.from_json(data["discretiser"]),
+            tree=DecisionTree.from_json(data["tree"]),
+            rules=IntentRules.from_json(data["intent_rules"]),
+            root_entropy=float(data["root_entropy"]),
+            root_gains=tuple((str(a), float(g)) for a, g in data["root_gains"]),
+            provenance=dict(data["provenance"]),
+        )
+    except (KeyError, TypeError) as err:
+        raise ValueError(f"malformed tree: {type(err).__name__} {err}") from err
+
+
+def dumps(model: TreeModel | IntentTreeModel) -> str:
+    data = (
+        intent_model_to_json(model) if isinstance(model, IntentTreeModel) else model_to_json(model)
+    )
+    return json.dumps(data, indent=1, allow_nan=False) + "\n"
+
+
+def save_model(model: TreeModel | IntentTreeModel, path: Path) -> None:
     write_text_atomically(Path(path), dumps(model))
+
+
+def _read(path: Path) -> str:
+    try:
+        return Path(path).read_text(encoding="utf-8")
+    except OSError as err:
+        raise UserError(f"{path}: cannot read tree file: {err.strerror or err}") from err
+
+
+def load_intent_model(path: Path) -> IntentTreeModel:
+    """Read a ground intent tree file; UserError (naming the file) otherwise."""
+    text = _read(path)
+    try:
+        return intent_model_from_json(json.loads(text))
+    except json.JSONDecodeError as err:
+        raise UserError(f"{path}: line {err.lineno}: not valid JSON: {err.msg}") from err
+    except ValueError as err:
+        raise UserError(f"{path}: {err}") from err
+
+
+def load_any_model(path: Path) -> TreeModel | IntentTreeModel:
+    """Either kind of tree file, by its version (for `tree show`)."""
+    text = _read(path)
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as err:
+        raise UserError(f"{path}: line {err.lineno}: not valid JSON: {err.msg}") from err
+    if isinstance(data, dict) and data.get("version") == INTENT_VERSION:
+        return load_intent_model(path)
+    return _parse(text, str(path))
 
 
 def load_model(path: Path) -> TreeModel:
     """Read a tree file; UserError (naming the file) if it is unreadable or malformed."""
-    path = Path(path)
-    try:
-        text = path.read_text(encoding="utf-8")
-    except OSError as err:
-        raise UserError(f"{path}: cannot read tree file: {err.strerror or err}") from err
-    return _parse(text, str(path))
+    return _parse(_read(path), str(path))
 
 
 def _parse(text: str, where: str) -> TreeModel:
@@ -134,3 +226,15 @@ def tree_predictor(mode: Mode, model: Path | None = None) -> TreePredictor:
         where = model if model is not None else "the shipped default tree"
         raise UserError(f"{where}: tree was trained for {tree.mode} mode, not {mode} mode")
     return TreePredictor(tree)
+
+
+def intent_tree_predictor(mode: Mode, model: Path | None = None) -> IntentTreePredictor:
+    """The `intent-tree` entry of the predictor registry: needs a ground intent tree file."""
+    if mode is not Mode.GROUND:
+        raise UserError(f"predictor 'intent-tree' predicts in ground mode only, not {mode} mode")
+    if model is None:
+        raise UserError(
+            "predictor 'intent-tree' needs a tree file (none is shipped): train one with "
+            "`monopic tree train --mode ground DATASET_DIR --out TREE.json`"
+        )
+    return IntentTreePredictor(load_intent_model(model))

@@ -86,7 +86,14 @@ def methods(rows: Iterable[RunResult]) -> list[str]:
     return sorted(found, key=_method_order)
 
 
-_ORDER = {"image": 0, "ground": 1, "rules": 0, "tree": 1, "constant-velocity": 2}
+_ORDER = {
+    "image": 0,
+    "ground": 1,
+    "rules": 0,
+    "tree": 1,
+    "constant-velocity": 2,
+    "intent-tree": 3,
+}
 
 
 def _method_order(method: str) -> tuple[int, int, int, str]:
@@ -435,6 +442,118 @@ def case_summary(rows: Sequence[RunResult], method: str) -> CaseSummary:
     return CaseSummary(method, int(confusion.sum()), int(np.trace(confusion)), confusion)
 
 
+BEFORE_CHANGE_S = 1.5  # the issue's window before each change of behaviour
+
+
+@dataclass(frozen=True)
+class Accuracy:
+    """Right answers over frames, on all frames and on those just before a change."""
+
+    frames: int = 0
+    correct: int = 0
+    before_frames: int = 0
+    before_correct: int = 0
+
+    def __add__(self, other: Accuracy) -> Accuracy:
+        return Accuracy(
+            self.frames + other.frames,
+            self.correct + other.correct,
+            self.before_frames + other.before_frames,
+            self.before_correct + other.before_correct,
+        )
+
+    @property
+    def accuracy(self) -> float:
+        return ratio(self.correct, self.frames)
+
+    @property
+    def before_accuracy(self) -> float:
+        return ratio(self.before_correct, self.before_frames)
+
+
+def before_change(times: Sequence[float | None], labels: Sequence[str | None]) -> list[bool]:
+    """Frames within BEFORE_CHANGE_S before a frame whose true intent differs from the last."""
+    changes = [
+        t for k, t in enumerate(times)
+        if k and t is not None and labels[k] is not None and labels[k - 1] is not None
+        and labels[k] != labels[k - 1]
+    ]  # fmt: skip
+    return [t is not None and any(0 < c - t <= BEFORE_CHANGE_S for c in changes) for t in times]
+
+
+def _accuracy(said: Sequence[Any], truth: Sequence[Any], near: Sequence[bool]) -> Accuracy:
+    out = Accuracy()
+    for s, t, b in zip(said, truth, near, strict=True):
+        if s is None or t is None:
+            continue
+        hit = int(s == t)
+        out = out + Accuracy(1, hit, int(b), hit * int(b))
+    return out
+
+
+@dataclass(frozen=True)
+class IntentSummary:
+    """Intent and case accuracy of a predictor that states an intent, beside the
+    current-velocity baseline's case accuracy on the same frames."""
+
+    method: str
+    intent: Accuracy
+    case: Accuracy
+    baseline_case: Accuracy  # truth.case_now (the case of the velocity now) as the answer
+    # Frames where its ground point and constant velocity's (same pipeline) are both known
+    # against the truth, those where they differ by more than DIFFERS_M, and the median
+    # error (m) of each on the differing frames.
+    compared: int = 0
+    differing: int = 0
+    error_m: float = math.nan
+    cv_error_m: float = math.nan
+
+    @property
+    def differing_share(self) -> float:
+        return ratio(self.differing, self.compared)
+
+
+DIFFERS_M = 0.05  # m: closer than this, the two points are the same prediction
+
+
+def intent_summary(rows: Sequence[RunResult], method: str) -> IntentSummary | None:
+    """None when the method states no intent or the lines carry no intent labels."""
+    intent = case = baseline = Accuracy()
+    seen = False
+    pipeline, key = split_method(method)
+    cv_method = method_name(pipeline, f"constant-velocity/{key.partition('/')[2]}")
+    compared, errors, cv_errors = 0, [], []
+    for row in rows:
+        cols = _decisions(row, method)
+        truth = row.truth
+        if not cols or not cols.intent or not truth.intent:
+            continue
+        seen = True
+        cv = _decisions(row, cv_method)
+        for k, future in enumerate(truth.future if cv else ()):
+            mine, theirs = cols.ground[k], cv.ground[k] if cv else None
+            if mine is None or theirs is None or future is None:
+                continue
+            if None in mine + theirs + future:
+                continue
+            compared += 1
+            if math.dist(mine, theirs) > DIFFERS_M:
+                errors.append(math.dist(mine, future))
+                cv_errors.append(math.dist(theirs, future))
+        near = before_change(truth.t, truth.intent)
+        decided = [w is not None for w in cols.warn]
+        intent = intent + _accuracy(cols.intent, truth.intent, near)
+        case = case + _accuracy(cols.case, truth.case, near)
+        now = [c if d else None for c, d in zip(truth.case_now, decided, strict=True)]
+        baseline = baseline + _accuracy(now, truth.case, near)
+    if not seen:
+        return None
+    median = lambda v: float(np.median(v)) if v else math.nan  # noqa: E731
+    return IntentSummary(
+        method, intent, case, baseline, compared, len(errors), median(errors), median(cv_errors)
+    )
+
+
 @dataclass(frozen=True)
 class PositionSummary:
     """Error of the predicted point at the real horizon (image px; ground m when predicted)."""
@@ -622,6 +741,7 @@ class SweepMetrics:
     codes: tuple[str, ...] = ()  # sim.runs.code_version of the runs ("unknown" before it existed)
     # method -> (walker model, "cues" or "no cues") -> summary
     by_behaviour: dict[str, dict[tuple[str, str], WarningSummary]] = field(default_factory=dict)
+    intents: dict[str, IntentSummary] = field(default_factory=dict)  # methods stating one
 
 
 def _machine(row: RunResult) -> str:
@@ -663,4 +783,7 @@ def compute(rows: Sequence[RunResult]) -> SweepMetrics:
         frame_sizes=tuple(sizes),
         machines=tuple(machines),
         codes=tuple(sorted({str(r.code or UNKNOWN) for r in rows})),
+        intents={
+            m: summary for m in all_methods if (summary := intent_summary(rows, m)) is not None
+        },
     )

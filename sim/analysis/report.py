@@ -373,6 +373,7 @@ def write_report(
             ],
         ),  # fmt: skip
         "",
+        *_intent_table(m),
         "Position error at the real horizon: the predicted foot point against the true foot",
         "point one horizon later (pixels), and the predicted ground point against the true",
         "future position in the robot's frame (metres, ground mode only).",
@@ -436,3 +437,52 @@ def _found_tables(m: SweepMetrics) -> list[str]:
             )
             out.append("")
     return out
+
+
+def _intent_table(m: SweepMetrics) -> list[str]:
+    """Intent and case accuracy of predictors stating an intent, on all frames and in the
+    1.5 s before each change of the true intent, beside the current-velocity baseline."""
+    if not m.intents:
+        return []
+    rows = []
+    for x, s in m.intents.items():
+        rows.append(
+            [
+                x,
+                str(s.intent.frames),
+                pct(s.intent.accuracy),
+                pct(s.intent.before_accuracy),
+                pct(s.case.accuracy),
+                pct(s.case.before_accuracy),
+                pct(s.baseline_case.accuracy),
+                pct(s.baseline_case.before_accuracy),
+                str(s.intent.before_frames),
+                pct(s.differing_share),
+                f"{num(s.error_m)} / {num(s.cv_error_m)}",
+            ]
+        )
+    return [
+        "Intent (predictors that state one): accuracy on the frames they decided, and on "
+        "those in the 1.5 s before a change of the true intent; the baseline answers the "
+        "case of the true velocity now on the same frames. 'differs': the share of frames "
+        "where its ground point is more than 5 cm from constant velocity's, and the median "
+        "error (m) of each on those frames (it / constant velocity).",
+        "",
+        *table(
+            [
+                "method",
+                "frames",
+                "intent acc.",
+                "before change",
+                "case acc.",
+                "before change",
+                "baseline case acc.",
+                "before change",
+                "frames before",
+                "differs",
+                "m err there",
+            ],
+            rows,
+        ),  # fmt: skip
+        "",
+    ]

@@ -169,11 +169,10 @@ def kept_recordings(folder: Path, record: str) -> str:
 
 def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
     """Runs per family, what the results file already holds and the estimated time."""
-    from sim.runs.code_version import code_version
     from sim.runs.estimate import SWEEP_START_S, bench_frame_seconds, estimate_time
     from sim.runs.result import SCHEMA
     from sim.runs.results_file import read_rows, scan
-    from sim.runs.sweep import expand_spec
+    from sim.runs.sweep import expand_spec, sweep_code
 
     runs = expand_spec(spec)
     state = scan(out) if out.exists() else None
@@ -189,6 +188,8 @@ def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
         families.setdefault(r.family, []).append(r)
     print(f"{spec.path}: {len(runs)} runs in {len(families)} families, {already} already in "
           f"{out}, {len(todo)} to run{limit}")  # fmt: skip
+    if spec.intent_tree is not None:
+        print(f"  also predictor intent-tree/ground with {spec.intent_tree}")
     width = max(len("family"), *(len(f) for f in families))
     print(f"  {'family':<{width}}  {'kind':<9}  {'scale':<5}  runs  to run  frames (at most)")
     for family, members in sorted(families.items()):
@@ -218,7 +219,7 @@ def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
         SWEEP_START_S,
     )  # fmt: skip
     print(f"time: {time.text()}")
-    other = state.other_code(code_version()) if state else None
+    other = state.other_code(sweep_code(spec)) if state else None
     if other:
         print(f"{out}: {sum(other.values())} of its runs were made by other code "
               "(a sweep would stop; --restart sets them aside)")  # fmt: skip

@@ -64,6 +64,8 @@ class TruthRecorder(Listener):
         c.robot_speed.append(rounded(truth.robot.speed, 3))
         c.head_yaw.append(rounded(math.degrees(truth.head_yaw_shoulders), 1))
         c.head_yaw_camera.append(rounded(math.degrees(truth.head_yaw_camera), 1))
+        c.intent.append(truth.intent.value)
+        c.case_now.append(int(truth.case_now))
 
 
 @dataclass
@@ -100,12 +102,17 @@ class PipelineRecorder(Listener):
             cols.foot.append(rounded_point(d.prediction.foot, 1))
             cols.ground.append(rounded_point(d.prediction.ground, 3))
             cols.ttc.append(rounded(d.warning.time_to_contact, 3))
+            if d.prediction.intent is not None or cols.intent:  # only predictors stating one
+                cols.intent.extend([None] * (k - len(cols.intent)))
+                cols.intent.append(d.prediction.intent)
 
     def finished(self) -> PipelineColumns:
         """The columns, every predictor's padded to the frames run."""
         for cols in self.columns.decisions.values():
             for col in _columns(cols):
                 col.extend([None] * (self.frames - len(col)))
+            if cols.intent:
+                cols.intent.extend([None] * (self.frames - len(cols.intent)))
         return self.columns
 
 

@@ -7,6 +7,7 @@ pose (image and ground mode side by side).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from pathlib import Path
 
 from monopic.pipeline import Pipeline, PipelineConfig
 from monopic.pose.tracker import TrackerConfig
@@ -23,6 +24,8 @@ PREDICTORS: tuple[tuple[str, Mode], ...] = (
     ("rules", Mode.GROUND),
     ("constant-velocity", Mode.GROUND),
 )
+
+INTENT_TREE = "intent-tree"  # the registry name of the ground intent tree (a spec names its file)
 
 
 def scenario_pipeline(
@@ -41,8 +44,13 @@ def scenario_pipeline(
     return Pipeline(config, predictors)
 
 
-def make_pipeline(scenario: Scenario, ablation: bool = False) -> Pipeline:
+def make_pipeline(
+    scenario: Scenario, ablation: bool = False, intent_tree: Path | None = None
+) -> Pipeline:
     """All predictors on one pose, the sweep's pipeline.
+
+    With `intent_tree` (a sweep spec's `intent_tree` file) the ground intent tree runs
+    too, last, so the primary predictor and the others' outputs are unchanged.
 
     The ablation's tracker never detects (a threshold above any score, and no tiles so a
     failed crop costs one whole-frame pass): it only ever sees the true crop, so what it
@@ -52,4 +60,6 @@ def make_pipeline(scenario: Scenario, ablation: bool = False) -> Pipeline:
         TrackerConfig(threads=1, min_detection_score=1.01, acquire_tiles=()) if ablation else None
     )
     predictors = [make_predictor(name, mode) for name, mode in PREDICTORS]
+    if intent_tree is not None:
+        predictors.append(make_predictor(INTENT_TREE, Mode.GROUND, intent_tree))
     return scenario_pipeline(scenario, predictors, tracker)

@@ -62,6 +62,10 @@ class TruthColumns:
     # facing, and from the line to the camera (0: at it). Empty on lines before them.
     head_yaw: list[float | None] = field(default_factory=list)
     head_yaw_camera: list[float | None] = field(default_factory=list)
+    # The intent labels (sim.world.intent): what the path does within the horizon, and the
+    # case of the velocity now (the current-velocity baseline). Empty on lines before them.
+    intent: list[str | None] = field(default_factory=list)
+    case_now: list[int | None] = field(default_factory=list)
 
 
 @dataclass
@@ -73,6 +77,8 @@ class DecisionColumns:
     foot: list[list[float | None] | None] = field(default_factory=list)  # predicted, px
     ground: list[list[float | None] | None] = field(default_factory=list)  # predicted, m
     ttc: list[float | None] = field(default_factory=list)  # predicted time to contact, s
+    # The intent class a predictor states (the intent tree); empty for the others.
+    intent: list[str | None] = field(default_factory=list)
 
 
 @dataclass

@@ -30,4 +30,5 @@ class RunSpec:
     # or raised a false alarm, "all" keeps every run, "none" records nothing.
     record: str = "none"
     record_dir: str = ""
+    intent_tree: str = ""  # a ground intent tree file: also run predictor intent-tree/ground
     code: str = ""  # sim.runs.code_version of the code that runs it, written into the result

@@ -108,9 +108,11 @@ def run(
     """
     scenario = spec.scenario
     start = time.perf_counter()
-    onboard = [OnBoard(MAIN, make_pipeline(scenario))]
+    tree = Path(spec.intent_tree) if spec.intent_tree else None
+    onboard = [OnBoard(MAIN, make_pipeline(scenario, intent_tree=tree))]
     if spec.ablation:
-        onboard.append(OnBoard(ABLATION, make_pipeline(scenario, ablation=True), truth_region))
+        ablation = make_pipeline(scenario, ablation=True, intent_tree=tree)
+        onboard.append(OnBoard(ABLATION, ablation, truth_region))
     truth = TruthRecorder()
     recorders = {board.name: PipelineRecorder(board.name) for board in onboard}
     times = StepTimes()

@@ -5,6 +5,7 @@ A sweep spec (scenarios/sweeps/*.toml, documented in scenarios/README.md):
     name = "demo"
     ablation = true                 # also run the ground-truth-crop pipeline
     licence = "CC-BY-4.0"           # only for `monopic dataset` (a sweep ignores it)
+    intent_tree = "../trees/ground.json"  # optional: also run predictor intent-tree/ground
     [[include]]
     files = ["../families/car/*.toml"]   # globs, relative to the spec
     sampling = "random"             # "file" (as each file says), "base", "grid", "random"
@@ -49,7 +50,7 @@ from sim.scenario.files import (
 from sim.scenario.toml_table import TomlTable, read_toml
 
 INCLUDE_SAMPLING = ("file", "base", "grid", "random")
-SPEC_KEYS = ("name", "description", "ablation", "licence", "include")
+SPEC_KEYS = ("name", "description", "ablation", "licence", "intent_tree", "include")
 
 
 @dataclass(frozen=True)
@@ -72,6 +73,9 @@ class SweepSpec:
     includes: tuple[Include, ...]
     # The licence a dataset of these runs states (`monopic dataset`); a sweep ignores it.
     licence: str | None = None
+    # A ground intent tree file (`monopic tree train --mode ground`): every run also runs
+    # predictor intent-tree/ground with it, after the fixed ones (a dataset ignores it).
+    intent_tree: Path | None = None
 
 
 def load_spec(path: Path | str) -> SweepSpec:
@@ -95,6 +99,7 @@ def parse_spec(
     description = top.text("description", "")
     ablation = top.flag("ablation", True)
     licence = top.text("licence", None, nonempty=True)
+    intent_tree = _intent_tree(top, path)
     includes = []
     for entry in top.tables("include"):
         patterns = entry.raw("files")
@@ -124,7 +129,24 @@ def parse_spec(
     top.done()
     if not includes:
         raise ScenarioFileError(path, "include", [], "a sweep needs at least one [[include]]")
-    return SweepSpec(path, name, description, ablation, tuple(includes), licence)
+    return SweepSpec(path, name, description, ablation, tuple(includes), licence, intent_tree)
+
+
+def _intent_tree(top: TomlTable, path: Path) -> Path | None:
+    """The spec's `intent_tree`, relative to the spec, checked by loading it."""
+    value = top.text("intent_tree", None, nonempty=True)
+    if value is None:
+        return None
+    tree = Path(value) if Path(value).is_absolute() else path.parent / value
+    if not tree.is_file():
+        raise top.error("intent_tree", value, f"no such file ({tree})")
+    from monopic.tree.serialise import load_intent_model
+
+    try:
+        load_intent_model(tree)
+    except UserError as err:
+        raise top.error("intent_tree", value, str(err)) from None
+    return tree.resolve()
 
 
 def _glob(base: Path, pattern: str) -> list[Path]:
@@ -196,6 +218,7 @@ def expand_spec(spec: SweepSpec) -> list[RunSpec]:
                         params={k: _plain(v) for k, v in params.items()},
                         sweep=spec.name,
                         ablation=spec.ablation,
+                        intent_tree=str(spec.intent_tree) if spec.intent_tree else "",
                     )
                 )
     return runs
@@ -239,6 +262,18 @@ def set_aside(out: Path, folder: Path, tag: str) -> None:
         print(f"set aside: {source} -> {target}", file=sys.stderr)
 
 
+def sweep_code(spec: SweepSpec) -> str:
+    """The code version its results carry: with an intent tree, the tree file's digest too.
+
+    So a results file made with one tree is not resumed with another (it is "other code").
+    """
+    code = code_version()
+    if spec.intent_tree is None:
+        return code
+    digest = hashlib.sha256(spec.intent_tree.read_bytes()).hexdigest()[:8]
+    return f"{code}+tree-{digest}"
+
+
 def run_sweep(
     spec: SweepSpec,
     out: Path,
@@ -258,7 +293,7 @@ def run_sweep(
     A results file holding runs of other code (sim.runs.code_version) is not resumed: that
     is an error, or with `restart` the file and its recordings are set aside first.
     """
-    code = code_version()
+    code = sweep_code(spec)
     runs = expand_spec(spec)
     if ablation is not None:
         runs = [replace(r, ablation=ablation) for r in runs]

@@ -119,6 +119,9 @@ def test_every_predictor_calls_itself_by_its_registry_name():
             try:
                 predictor = make_predictor(name, mode)
             except UserError as err:  # the shipped tree is an image-mode tree
+                if name == "intent-tree":  # no ground intent tree is shipped
+                    assert "needs a tree file" in str(err) or "ground mode only" in str(err)
+                    continue
                 assert name == "tree" and "ground mode" in str(err)
                 continue
             assert predictor.name == name and predictor.mode is mode

@@ -181,3 +181,10 @@ def test_the_worlds_truth_carries_the_labels() -> None:
             assert truth.intent is Intent.KEEP_GOING and truth.intent_time is None
     row = truths[20].to_dict()
     assert (row["intent"], row["case_now"]) == ("stop", int(Case.PERPENDICULAR_RIGHT))
+
+
+def test_the_pipelines_intent_vocabulary_is_the_simulators() -> None:
+    """The intent tree (monopic) reads these labels from datasets; it cannot import sim."""
+    from monopic.tree.intent import INTENTS
+
+    assert tuple(i.value for i in Intent) == INTENTS

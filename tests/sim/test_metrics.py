@@ -277,3 +277,67 @@ def test_two_sweeps_beside_each_other_cell_by_cell(tmp_path: Path) -> None:
     assert fam[("f2", KEY)][3] == "- / 1"  # a family only the other sweep holds
     report = write_report(rail, [], tmp_path / "rail.jsonl", tmp_path / "rep", ("human", human))
     assert "## Beside human" in report.markdown.read_text()
+
+
+def test_frames_before_a_change_of_intent_are_the_last_1_5_s_before_it() -> None:
+    from sim.analysis.metrics import before_change
+
+    times = [k * 0.5 for k in range(8)]  # 0 .. 3.5 s
+    labels = ["keep going"] * 5 + ["stop"] * 3  # changes at 2.5 s
+    assert before_change(times, labels) == [False, False, True, True, True, False, False, False]
+    assert not any(before_change(times, ["keep going"] * 8))
+    with_gap = [*labels[:4], None, *labels[5:]]  # an unknown label is no change
+    assert not any(before_change(times, with_gap))
+
+
+def test_intent_accuracy_counts_decided_frames_and_those_before_a_change() -> None:
+    from sim.analysis.metrics import Accuracy, _accuracy
+
+    said = ["stop", None, "keep going", "stop"]
+    truth = ["stop", "stop", "stop", "stop"]
+    near = [True, True, False, True]
+    got = _accuracy(said, truth, near)
+    assert got == Accuracy(frames=3, correct=2, before_frames=2, before_correct=2)
+    assert got.accuracy == 2 / 3 and got.before_accuracy == 1.0
+
+
+def test_intent_summary_against_the_truth_and_constant_velocity() -> None:
+    """Hand-made columns: the tree states intents; where its point leaves constant
+    velocity's, the errors of both are reported there."""
+    import dataclasses
+
+    from sim.analysis.metrics import intent_summary
+    from sim.runs.result import DecisionColumns
+
+    n = 6
+    base = row("r", [None] * n, [0] * n)
+    truth = dataclasses.replace(
+        base.truth,
+        intent=["keep going"] * 3 + ["stop"] * 3,  # changes at 0.3 s
+        case_now=[5, 5, 5, 9, 9, 9],
+        case=[5, 5, 9, 9, 9, 9],
+    )
+    tree = DecisionColumns(
+        warn=[0] * n,
+        case=[5, 5, 9, 9, 9, 5],
+        foot=[None] * n,
+        ground=[[1.0, 0.0], [1.0, 0.0], [1.0, 0.0], [1.0, 0.0], [1.5, 0.0], [1.0, 0.0]],
+        ttc=[None] * n,
+        intent=["keep going", "stop", "stop", "stop", "stop", "keep going"],
+    )
+    cv = DecisionColumns(
+        warn=[0] * n, case=[5] * n, foot=[None] * n, ground=[[1.0, 0.0]] * n, ttc=[None] * n
+    )
+    main = dataclasses.replace(
+        base.pipelines["main"],
+        decisions={"intent-tree/ground": tree, "constant-velocity/ground": cv},
+    )
+    r = dataclasses.replace(base, truth=truth, pipelines={"main": main})
+    s = intent_summary([r], "intent-tree/ground")
+    assert s is not None
+    assert (s.intent.frames, s.intent.correct) == (6, 3)  # frames 1, 2 and 5 wrong
+    assert (s.intent.before_frames, s.intent.before_correct) == (3, 1)  # frames 0-2
+    assert (s.case.correct, s.baseline_case.correct) == (5, 5)
+    assert (s.compared, s.differing) == (6, 1)  # frame 4: 0.5 m from constant velocity
+    assert s.error_m == 0.5 and s.cv_error_m == 0.0  # the truth's future is (1, 0)
+    assert intent_summary([r], "constant-velocity/ground") is None  # states no intent

@@ -149,8 +149,11 @@ def test_sweep_writes_one_line_per_run_and_resumes_without_loss(
     assert set(record.pipelines) == {"main", "gtcrop"}
     n = record.frames
     assert len(record.truth.t) == n
+    assert len(record.truth.intent) == len(record.truth.case_now) == n
     for cols in record.pipelines["main"].decisions.values():
-        assert all(len(v) == n for v in vars(cols).values())
+        # The intent column is kept only by predictors stating one (none run here).
+        assert cols.intent == []
+        assert all(len(v) == n for k, v in vars(cols).items() if k != "intent")
 
     # Runs that went wrong (missed collision, false alarm) keep a recording, the others not.
     recorded = sorted(r["recording"] for r in read_rows(out) if r["recording"])
@@ -325,3 +328,92 @@ def test_bad_spec_and_results_are_one_line_errors(
     assert main(["report", str(tmp_path / "none.jsonl")]) == 2
     assert "no such results file" in capsys.readouterr().err
     assert main(["sweep", str(spec), "--address", "h:1"]) == 2
+
+
+def _intent_tree_file(path: Path) -> Path:
+    """A one-leaf ground intent tree file (hand-made: what matters is that it loads)."""
+    from monopic.tree.intent import IntentRules
+    from monopic.tree.serialise import save_model
+    from tests.monopic.test_intent_tree import leaf_model
+
+    path.parent.mkdir(parents=True, exist_ok=True)
+    save_model(leaf_model("6/stop", 30, IntentRules(hold_back_support=0.8)), path)
+    return path
+
+
+def test_a_spec_names_an_intent_tree_relative_to_itself_and_runs_it_last(tmp_path: Path) -> None:
+    from sim.runs.pipelines import PREDICTORS, make_pipeline
+    from sim.runs.sweep import expand_spec, load_spec
+
+    (tmp_path / "tiny.toml").write_text(SCENARIO)
+    tree = _intent_tree_file(tmp_path / "trees" / "ground.json")
+    spec_file = tmp_path / "spec.toml"
+    spec_file.write_text('intent_tree = "trees/ground.json"\n' + SPEC.format(ablation="false"))
+    spec = load_spec(spec_file)
+    assert spec.intent_tree == tree.resolve()
+    runs = expand_spec(spec)
+    assert runs and all(r.intent_tree == str(tree.resolve()) for r in runs)
+    plain = make_pipeline(runs[0].scenario)
+    with_tree = make_pipeline(runs[0].scenario, intent_tree=Path(runs[0].intent_tree))
+    keys = [f"{n}/{m}" for n, m in PREDICTORS]
+    assert [f"{p.name}/{p.mode}" for p in plain.predictors] == keys
+    assert [f"{p.name}/{p.mode}" for p in with_tree.predictors] == [*keys, "intent-tree/ground"]
+    assert with_tree.primary == plain.primary
+    # Results carry the tree's digest in their code version: another tree is other code.
+    from sim.runs.code_version import code_version
+    from sim.runs.sweep import sweep_code
+
+    first = sweep_code(spec)
+    assert first.startswith(code_version() + "+tree-")
+    tree.write_text(tree.read_text().replace('"min_rows": 20', '"min_rows": 21'))
+    assert sweep_code(load_spec(spec_file)) not in (first, code_version())
+    (tmp_path / "plain.toml").write_text(SPEC.format(ablation="false"))
+    assert sweep_code(load_spec(tmp_path / "plain.toml")) == code_version()
+
+
+@pytest.mark.parametrize(
+    ("line", "expected"),
+    [
+        ('intent_tree = "nowhere.json"', "intent_tree = 'nowhere.json': no such file"),
+        ('intent_tree = "old.json"', "not a ground intent tree"),
+        ('intent_tre = "trees/ground.json"', "intent_tree"),
+    ],
+)
+def test_a_bad_intent_tree_key_is_one_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], line: str, expected: str
+) -> None:
+    from monopic.cli.main import main
+
+    (tmp_path / "tiny.toml").write_text(SCENARIO)
+    _intent_tree_file(tmp_path / "trees" / "ground.json")
+    shipped = Path(__file__).parents[2] / "monopic" / "tree" / "default_tree.json"
+    (tmp_path / "old.json").write_text(shipped.read_text())
+    spec_file = tmp_path / "spec.toml"
+    spec_file.write_text(line + "\n" + SPEC.format(ablation="false"))
+    assert main(["sweep", str(spec_file), "--dry-run"]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and str(spec_file) in err and expected in err, err
+
+
+def test_the_judged_intent_sweep_shares_no_run_or_seed_with_the_training_data() -> None:
+    """intent-judged draws other seeds and values outside intent-train's ranges."""
+    import tomllib
+
+    from sim.runs.sweep import expand_spec, load_spec, parse_spec
+    from tests.paths import SCENARIOS
+
+    train = expand_spec(load_spec(SCENARIOS / "datasets" / "intent-train.toml"))
+    judged_path = SCENARIOS / "sweeps" / "intent-judged.toml"
+    data = tomllib.loads(judged_path.read_text())
+    assert data.pop("intent_tree") == "../../recordings/intent/ground.json"
+    judged = expand_spec(parse_spec(judged_path, data))  # the tree file is made later
+    assert {r.family for r in judged} == {r.family for r in train}
+    assert not {(r.family, r.scenario.seed) for r in train} & {
+        (r.family, r.scenario.seed) for r in judged
+    }
+    for key in ("scene.road.lane_width", "pedestrian.speed", "pedestrian.behaviour.stop_lead"):
+        top = max(r.params[key] for r in train)
+        assert min(r.params[key] for r in judged) > top, key
+    assert max(r.params["pedestrian.behaviour.head_check_probability"] for r in judged) < min(
+        r.params["pedestrian.behaviour.head_check_probability"] for r in train
+    )

@@ -1,0 +1,544 @@
+"""Training the ground intent tree on datasets the test bed made (`monopic dataset`).
+
+Rows: each run's features/<run>.csv (the pipeline's own per-frame values, what a robot
+computes) joined by frame number to truth/<run>.jsonl (the labels: next-second case,
+intent, true position a horizon later, whether the footprints meet). The truth is read
+here, to train and to choose options, never by the predictor.
+
+Split, so nothing judged is chosen on: runs are grouped by (family, seed); families
+given as excluded (the judged ones) are dropped entirely; the validation groups are the
+families named for it, else a deterministic hash share of the groups. Bins (MDL or
+quantile cut points fitted on the training rows) and depth are chosen by the median
+error of the tree's point on validation; the intent rules' thresholds by frame-level
+warnings on validation (fewest false warnings with no more misses than constant
+velocity). The winner is then the tree trained on the training rows alone.
+"""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+import zlib
+from collections.abc import Sequence
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from monopic.cases import Case
+from monopic.errors import UserError
+from monopic.tree.discretise import CutPointBins, Discretiser, entropy_discretiser
+from monopic.tree.id3 import ID3Params
+from monopic.tree.intent import (
+    INTENT_ATTRIBUTES,
+    INTENTS,
+    IntentRules,
+    IntentSample,
+    IntentTreeModel,
+    LeafReading,
+    fit_intent_model,
+    joint_label,
+    place,
+    shrink_corrections,
+)
+from monopic.variants.zone import RobotGeometry, meets_swept_footprint
+
+# features/<run>.csv column of each tree attribute (monopic.framelog's names).
+FEATURE_COLUMNS = {
+    "forward": "groundVx",
+    "left": "groundVy",
+    "speed": "groundSpeed",
+    "acceleration": "groundAcceleration",
+    "heading_rate": "groundHeadingRate",
+    "phi": "angleOfApproach",
+    "phi_rate": "phiRate",
+    "head_yaw": "headYaw",
+    "path_offset": "pathOffset",
+    "path_distance": "pathDistance",
+}
+POSITION_COLUMNS = ("groundX", "groundY")
+TRUTH_KEYS = ("frame", "time", "case", "intent", "future_position_robot", "collision", "robot")
+BINNINGS = ("mdl", "q2", "q3", "q4")
+DEPTHS = (1, 2, 3, 4, 6)
+SHRINKS: tuple[float | None, ...] = (0.0, 20.0, 100.0, None)  # None: constant velocity's point
+SUPPORTS = (0.5, 0.6, 0.7, 0.8, 0.9, 1.01)  # 1.01: the rule off
+START_SPEEDS = (0.6, 1.0, 1.4)
+DEFAULT_MIN_SAMPLES = 20
+
+
+@dataclass(frozen=True)
+class LabelledRow:
+    """A training row and what judging a warning on it needs (robot from the truth)."""
+
+    sample: IntentSample
+    collision: bool
+    robot: RobotGeometry
+    robot_speed: float
+    robot_yaw_rate: float
+
+
+@dataclass(frozen=True)
+class RunRows:
+    """One dataset run's rows."""
+
+    run: str
+    family: str
+    seed: int
+    rows: tuple[LabelledRow, ...]
+    horizon: float
+
+    @property
+    def group(self) -> tuple[str, int]:
+        return (self.family, self.seed)
+
+
+def _number(text: str, where: str, column: str) -> float:
+    if text.strip() == "":
+        return math.nan
+    try:
+        return float(text)
+    except ValueError:
+        raise UserError(f"{where}: {column} = {text!r}: not a number") from None
+
+
+def read_dataset(folder: Path) -> list[RunRows]:
+    """Every run of a dataset folder as labelled rows; UserError naming file and field."""
+    folder = Path(folder)
+    runs_csv = folder / "runs.csv"
+    if not runs_csv.is_file():
+        raise UserError(
+            f"{folder}: not a dataset folder (no runs.csv): make one with "
+            "`monopic dataset SPEC.toml --out DIR`"
+        )
+    with runs_csv.open(encoding="utf-8", newline="") as fh:
+        reader = csv.DictReader(fh)
+        for column in ("run", "family", "seed"):
+            if column not in (reader.fieldnames or []):
+                raise UserError(f"{runs_csv}: no column {column!r}")
+        entries = list(reader)
+    out = []
+    for line, entry in enumerate(entries, start=2):
+        try:
+            seed = int(entry["seed"])
+        except ValueError:
+            raise UserError(
+                f"{runs_csv}: line {line}: seed = {entry['seed']!r}: not an integer"
+            ) from None
+        out.append(_read_run(folder, entry["run"], entry["family"], seed))
+    return out
+
+
+def _read_truth(path: Path) -> dict[int, dict[str, Any]]:
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+    except OSError as err:
+        raise UserError(f"{path}: cannot read: {err.strerror or err}") from None
+    truth: dict[int, dict[str, Any]] = {}
+    for n, text in enumerate(lines, start=1):
+        if not text.strip():
+            continue
+        try:
+            t = json.loads(text)
+        except json.JSONDecodeError as err:
+            raise UserError(f"{path}: line {n}: not valid JSON: {err.msg}") from None
+        for key in TRUTH_KEYS:
+            if key not in t:
+                raise UserError(f"{path}: line {n}: no field {key!r}")
+        if t["intent"] not in INTENTS:
+            raise UserError(
+                f"{path}: line {n}: intent = {t['intent']!r}: not one of {', '.join(INTENTS)}"
+            )
+        if not (isinstance(t["case"], int) and 1 <= t["case"] <= 9):
+            raise UserError(f"{path}: line {n}: case = {t['case']!r}: not a case number 1-9")
+        for key in ("length", "width", "speed", "yaw_rate"):
+            if not isinstance(t["robot"], dict) or key not in t["robot"]:
+                raise UserError(f"{path}: line {n}: no field 'robot.{key}'")
+        truth[int(t["frame"])] = t
+    return truth
+
+
+def _read_run(folder: Path, run: str, family: str, seed: int) -> RunRows:
+    features_path = folder / "features" / f"{run}.csv"
+    truth_path = folder / "truth" / f"{run}.jsonl"
+    truth = _read_truth(truth_path)
+    try:
+        fh = features_path.open(encoding="utf-8", newline="")
+    except OSError as err:
+        raise UserError(f"{features_path}: cannot read: {err.strerror or err}") from None
+    with fh:
+        reader = csv.DictReader(fh)
+        needed = ("frameNumber", "time", *POSITION_COLUMNS, *FEATURE_COLUMNS.values())
+        for column in needed:
+            if column not in (reader.fieldnames or []):
+                raise UserError(f"{features_path}: no column {column!r} (the ground tree reads it)")
+        rows = []
+        horizons = set()
+        for line, r in enumerate(reader, start=2):
+            where = f"{features_path}: line {line}"
+            x, y = (_number(r[c], where, c) for c in POSITION_COLUMNS)
+            if not (math.isfinite(x) and math.isfinite(y)):
+                continue  # no ground point: a ground predictor does not decide on this frame
+            frame = int(_number(r["frameNumber"], where, "frameNumber"))
+            t = truth.get(frame)
+            if t is None:
+                raise UserError(f"{where}: frameNumber = {frame}: no such frame in {truth_path}")
+            when = _number(r["time"], where, "time")
+            if not abs(when - float(t["time"])) < 1e-3:
+                raise UserError(
+                    f"{where}: time = {when}: frame {frame} of {truth_path} is at {t['time']}"
+                )
+            future = t["future_position_robot"]
+            if future is None or not all(v is not None and math.isfinite(v) for v in future):
+                continue
+            values = {a: _number(r[c], where, c) for a, c in FEATURE_COLUMNS.items()}
+            horizons.add(float(t.get("horizon", math.nan)))
+            robot = t["robot"]
+            rows.append(
+                LabelledRow(
+                    sample=IntentSample(
+                        values=values,
+                        case=Case(t["case"]),
+                        intent=t["intent"],
+                        position=(x, y),
+                        velocity=(values["forward"], values["left"]),
+                        future=(float(future[0]), float(future[1])),
+                    ),
+                    collision=bool(t["collision"]),
+                    robot=RobotGeometry(
+                        width=float(robot["width"]),
+                        length=float(robot["length"]),
+                        front=float(robot["length"]) / 2,
+                    ),
+                    robot_speed=float(robot["speed"]),
+                    robot_yaw_rate=float(robot["yaw_rate"]),
+                )
+            )
+    if len(horizons) > 1:
+        raise UserError(f"{truth_path}: horizon differs between frames: {sorted(horizons)}")
+    horizon = horizons.pop() if horizons else math.nan
+    return RunRows(run, family, seed, tuple(rows), horizon)
+
+
+@dataclass(frozen=True)
+class Split:
+    """Runs for training and for validation; the excluded ones are in neither."""
+
+    train: tuple[RunRows, ...]
+    validation: tuple[RunRows, ...]
+    excluded: tuple[RunRows, ...] = ()
+
+    def describe(self) -> str:
+        def part(name: str, runs: Sequence[RunRows]) -> str:
+            fams = sorted({r.family for r in runs})
+            rows = sum(len(r.rows) for r in runs)
+            return f"  {name:<10} {len(runs):>4} runs {rows:>6} rows  families: {', '.join(fams)}"
+
+        lines = ["Split by (family, seed):", part("train", self.train)]
+        lines.append(part("validation", self.validation))
+        if self.excluded:
+            lines.append(part("excluded", self.excluded) + "  (never trained or validated on)")
+        return "\n".join(lines)
+
+
+def _share_of(group: tuple[str, int]) -> float:
+    return zlib.crc32(f"{group[0]}:{group[1]}".encode()) / 2**32
+
+
+def split_runs(
+    runs: Sequence[RunRows],
+    validation_share: float = 0.25,
+    validation_families: Sequence[str] = (),
+    excluded_families: Sequence[str] = (),
+) -> Split:
+    """Group by (family, seed); excluded families out, then validation by name or hash share.
+
+    Every group goes wholly to one side. With a hash share, at least one group goes to
+    each side when there are two groups or more.
+    """
+    if not 0 < validation_share < 1:
+        raise ValueError(f"validation share must be in (0, 1), got {validation_share}")
+    known = {r.family for r in runs}
+    for name in (*validation_families, *excluded_families):
+        if name not in known:
+            raise UserError(f"family {name!r} is in no dataset given: {', '.join(sorted(known))}")
+    both = set(validation_families) & set(excluded_families)
+    if both:
+        raise UserError(f"family {sorted(both)[0]!r} is both validated on and excluded")
+    excluded = tuple(r for r in runs if r.family in excluded_families)
+    kept = [r for r in runs if r.family not in excluded_families]
+    groups = sorted({r.group for r in kept})
+    if validation_families:
+        chosen = {g for g in groups if g[0] in validation_families}
+    else:
+        chosen = {g for g in groups if _share_of(g) < validation_share}
+        if len(groups) >= 2 and not chosen:
+            chosen = {min(groups, key=_share_of)}
+        if len(groups) >= 2 and len(chosen) == len(groups):
+            chosen.discard(max(groups, key=_share_of))
+    train = tuple(r for r in kept if r.group not in chosen)
+    validation = tuple(r for r in kept if r.group in chosen)
+    if not train or not validation:
+        raise UserError(
+            f"the split leaves {len(train)} training and {len(validation)} validation runs: "
+            "both need at least one (more runs, or other --validate-family)"
+        )
+    return Split(train, validation, excluded)
+
+
+@dataclass(frozen=True)
+class Candidate:
+    """One way to bin and grow the tree, and how far its corrections are shrunk."""
+
+    binning: str
+    max_depth: int
+    shrink: float | None = 0.0  # rows (n / (n + shrink)); None: corrections off
+
+    def describe(self) -> str:
+        return f"{self.binning}, depth {self.max_depth}, {_shrink_text(self.shrink)}"
+
+
+def _shrink_text(shrink: float | None) -> str:
+    return "no correction" if shrink is None else f"shrink {shrink:g}"
+
+
+def quantile_cuts(values: Sequence[float], bins: int) -> tuple[float, ...]:
+    """Cut points at the training values' quantiles (finite values; duplicates merged)."""
+    v = np.asarray(values, dtype=float)
+    v = v[np.isfinite(v)]
+    if v.size == 0:
+        return ()
+    qs = np.quantile(v, [k / bins for k in range(1, bins)])
+    return tuple(sorted({float(q) for q in qs}))
+
+
+def make_discretiser(binning: str, samples: Sequence[IntentSample]) -> Discretiser:
+    """Cut points per attribute, fitted on `samples` (training rows only)."""
+    columns = {a: [s.values[a] for s in samples] for a in INTENT_ATTRIBUTES}
+    if binning == "mdl":
+        labels = [joint_label(s.case, s.intent) for s in samples]
+        return entropy_discretiser(columns, labels, INTENT_ATTRIBUTES, name="intent-mdl")  # type: ignore[arg-type]
+    if binning.startswith("q") and binning[1:].isdigit() and int(binning[1:]) >= 2:
+        n = int(binning[1:])
+        return Discretiser(
+            name=f"intent-{binning}",
+            binners=tuple(
+                (a, CutPointBins(quantile_cuts(columns[a], n))) for a in INTENT_ATTRIBUTES
+            ),
+        )
+    raise ValueError(f"unknown binning {binning!r}: one of {', '.join(BINNINGS)}")
+
+
+def _samples(runs: Sequence[RunRows]) -> list[IntentSample]:
+    return [row.sample for r in runs for row in r.rows]
+
+
+def point_error(model: IntentTreeModel, sample: IntentSample, rules: IntentRules) -> float:
+    """Metres between the predicted and the true point a horizon later."""
+    reading = LeafReading.of(model.tree.answer(model.discretiser.discretise(sample.values)))
+    (px, py), _, _ = place(
+        sample.position, sample.velocity, reading, rules, model.horizon, model.horizon
+    )
+    return math.hypot(px - sample.future[0], py - sample.future[1])
+
+
+def cv_error(sample: IntentSample, horizon: float) -> float:
+    dx, dy = sample.correction(horizon)
+    return math.hypot(dx, dy)
+
+
+@dataclass(frozen=True)
+class WarningCount:
+    """Frame-level warnings on validation rows against the truth's collision."""
+
+    misses: int
+    false_alarms: int
+    collisions: int
+    frames: int
+
+    def describe(self) -> str:
+        return (
+            f"missed {self.misses}/{self.collisions} collision frames, "
+            f"{self.false_alarms}/{self.frames - self.collisions} false warnings"
+        )
+
+
+def count_warnings(
+    points: Sequence[tuple[float, float]], rows: Sequence[LabelledRow], horizon: float
+) -> WarningCount:
+    """The ground warning (swept footprint, as monopic.variants.warning) on each row."""
+    misses = false_alarms = collisions = 0
+    for point, row in zip(points, rows, strict=True):
+        warned = (
+            meets_swept_footprint(
+                row.sample.position, point, row.robot, row.robot_speed, row.robot_yaw_rate, horizon
+            )
+            is not None
+        )
+        collisions += row.collision
+        misses += row.collision and not warned
+        false_alarms += warned and not row.collision
+    return WarningCount(misses, false_alarms, collisions, len(rows))
+
+
+@dataclass(frozen=True)
+class TrainResult:
+    """The trained model and the report of how its options were chosen."""
+
+    model: IntentTreeModel
+    split: Split
+    report: str
+    candidates: tuple[tuple[Candidate, float], ...] = field(default_factory=tuple)
+
+
+def train_intent_tree(
+    runs: Sequence[RunRows],
+    split: Split,
+    min_samples: int = DEFAULT_MIN_SAMPLES,
+    binnings: Sequence[str] = BINNINGS,
+    depths: Sequence[int] = DEPTHS,
+    shrinks: Sequence[float | None] = SHRINKS,
+    supports: Sequence[float] = SUPPORTS,
+    start_speeds: Sequence[float] = START_SPEEDS,
+    min_rows: int = DEFAULT_MIN_SAMPLES,
+    sources: Sequence[dict[str, Any]] = (),
+) -> TrainResult:
+    """Choose bins and depth, then the intent rules, on validation; fit on training rows."""
+    horizons = {r.horizon for r in runs if r.rows}
+    if len(horizons) != 1:
+        raise UserError(
+            f"the datasets' runs have different horizons {sorted(horizons)}: train on one"
+        )
+    horizon = horizons.pop()
+    train, val = _samples(split.train), _samples(split.validation)
+    val_rows = [row for r in split.validation for row in r.rows]
+    if not train or not val:
+        raise UserError(f"{len(train)} training and {len(val)} validation rows: both need some")
+    off = IntentRules(min_rows=min_rows)
+    cv_median = float(np.median([cv_error(s, horizon) for s in val]))
+    scored: list[tuple[Candidate, float, IntentTreeModel]] = []
+    for binning in binnings:
+        disc = make_discretiser(binning, train)
+        for depth in depths:
+            fitted = fit_intent_model(train, disc, ID3Params(min_samples, depth), horizon, off)
+            for shrink in shrinks:
+                model = replace(fitted, tree=shrink_corrections(fitted.tree, shrink))
+                err = float(np.median([point_error(model, s, off) for s in val]))
+                scored.append((Candidate(binning, depth, shrink), err, model))
+    # Lowest validation median error; ties (1 mm) to the shallower, the listed binning,
+    # then the more shrunk corrections.
+    best_cand, best_err, best = min(
+        scored,
+        key=lambda c: (
+            round(c[1], 3),
+            c[0].max_depth,
+            binnings.index(c[0].binning),
+            -list(shrinks).index(c[0].shrink),
+        ),
+    )
+    readings = [
+        LeafReading.of(best.tree.answer(best.discretiser.discretise(s.values))) for s in val
+    ]
+    cv_points = [
+        place(
+            s.position,
+            s.velocity,
+            LeafReading(Case.STILL, INTENTS[0], 1.0, 0, (0.0, 0.0)),
+            off,
+            horizon,
+            horizon,
+        )[0]
+        for s in val
+    ]
+    cv_count = count_warnings(cv_points, val_rows, horizon)
+    options = []
+    for hold in supports:
+        for warn in supports:
+            for speed in start_speeds if warn <= 1 else start_speeds[:1]:
+                rules = IntentRules(hold, warn, min_rows, speed)
+                points = [
+                    place(s.position, s.velocity, rd, rules, horizon, horizon)[0]
+                    for s, rd in zip(val, readings, strict=True)
+                ]
+                options.append((rules, count_warnings(points, val_rows, horizon)))
+    feasible = [o for o in options if o[1].misses <= cv_count.misses]
+    if feasible:
+        rules, count = min(
+            feasible,
+            key=lambda o: (
+                o[1].false_alarms,
+                o[1].misses,
+                -o[0].hold_back_support,
+                -o[0].warn_support,
+                o[0].start_speed,
+            ),
+        )
+    else:
+        rules, count = min(
+            options,
+            key=lambda o: (
+                o[1].misses,
+                o[1].false_alarms,
+                -o[0].hold_back_support,
+                -o[0].warn_support,
+                o[0].start_speed,
+            ),
+        )
+    provenance = {
+        "trained_by": "monopic tree train --mode ground",
+        "datasets": list(sources),
+        "horizon_s": horizon,
+        "min_samples": min_samples,
+        "split": {
+            "train": [r.run for r in split.train],
+            "validation": [r.run for r in split.validation],
+            "excluded": [r.run for r in split.excluded],
+        },
+        "chosen": {
+            "binning": best_cand.binning,
+            "max_depth": best_cand.max_depth,
+            "shrink_rows": best_cand.shrink,  # null: corrections off
+        },
+        "validation": {
+            "median_error_m": best_err,
+            "constant_velocity_median_error_m": cv_median,
+            "warnings": count.describe(),
+            "constant_velocity_warnings": cv_count.describe(),
+        },
+    }
+    model = IntentTreeModel(
+        best.horizon,
+        best.discretiser,
+        best.tree,
+        rules,
+        best.root_entropy,
+        best.root_gains,
+        provenance,
+    )
+    heads = "  ".join(f"{_shrink_text(x):>13}" for x in shrinks)
+    table = [
+        "Candidates (median error of the tree's point on validation, m):",
+        f"  {'bins, depth':<12} {heads}",
+    ]
+    for binning in binnings:
+        for depth in depths:
+            errs = [e for c, e, _ in scored if (c.binning, c.max_depth) == (binning, depth)]
+            cells = "  ".join(f"{e:>13.3f}" for e in errs)
+            table.append(f"  {f'{binning}, {depth}':<12} {cells}")
+    table.append(f"  constant velocity {cv_median:.3f}")
+    table.append(f"Chosen: {best_cand.describe()} ({best_err:.3f} m)")
+    table.append(
+        "Intent rules chosen on validation: hold back at support "
+        f"{_support(rules.hold_back_support)}, "
+        f"warn earlier at {_support(rules.warn_support)} (start speed {rules.start_speed:g} m/s), "
+        f"at least {rules.min_rows} leaf rows"
+    )
+    table.append(f"  with the rules: {count.describe()}")
+    table.append(f"  constant velocity: {cv_count.describe()}")
+    report = split.describe() + "\n" + "\n".join(table)
+    return TrainResult(model, split, report, tuple((c, e) for c, e, _ in scored))
+
+
+def _support(value: float) -> str:
+    return "off" if value > 1 else f"{value:g}"

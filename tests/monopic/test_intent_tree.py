@@ -1,0 +1,348 @@
+"""The ground intent tree: learning a known rule from hand-made dataset files, the split,
+the predictor's intent rules, the tree file, and the one-line errors on bad input."""
+
+from __future__ import annotations
+
+import csv
+import json
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from monopic.camera import CameraModel
+from monopic.cases import Case, case_from_ground_velocity
+from monopic.cli.main import main
+from monopic.errors import UserError
+from monopic.features.record import Features, GroundFeatures
+from monopic.frame import EgoState
+from monopic.predict.base import Mode
+from monopic.replay.intent_training import (
+    FEATURE_COLUMNS,
+    RunRows,
+    read_dataset,
+    split_runs,
+    train_intent_tree,
+)
+from monopic.tree.discretise import CutPointBins, Discretiser
+from monopic.tree.id3 import DecisionTree, Node
+from monopic.tree.intent import (
+    INTENT_ATTRIBUTES,
+    Action,
+    IntentRules,
+    IntentTreeModel,
+    IntentTreePredictor,
+    worst_case_ops,
+)
+from monopic.tree.serialise import (
+    load_default_model,
+    load_intent_model,
+    load_model,
+    save_model,
+)
+from monopic.variants.warning import CollisionWarning
+from monopic.variants.zone import RobotGeometry
+
+CAM = CameraModel.from_fov(768, 432, 70, 1.0, pitch_deg=5)
+SPEED = 1.3  # m/s, walking toward the robot's path from its right (+ left)
+ROBOT_SPEED = 2.0
+HORIZON = 1.0
+
+
+# --- hand-made dataset: stop exactly when slowing near the kerb ---------------------------
+
+
+def _row(rng: np.random.Generator, slowing: bool, near: bool) -> dict:
+    """One frame whose right answer is known: slowing near the kerb -> stop, else walk on."""
+    gap = rng.uniform(0.6, 0.9) if near else rng.uniform(2.5, 3.5)  # m, to the band's edge
+    y = -(0.3 + gap)
+    stop = slowing and near
+    future_y = y + (0.2 if stop else SPEED * HORIZON)
+    values = {
+        "forward": rng.normal(0, 0.05),
+        "left": SPEED + rng.normal(0, 0.05),
+        "speed": SPEED + rng.normal(0, 0.05),
+        "acceleration": rng.uniform(-1.6, -0.9) if slowing else rng.uniform(-0.2, 0.2),
+        "heading_rate": rng.normal(0, 20),
+        "phi": rng.uniform(-180, 180),
+        "phi_rate": rng.normal(0, 30),
+        "head_yaw": rng.normal(0, 10),
+        "path_offset": y,
+        "path_distance": gap,
+    }
+    return {
+        "values": values,
+        "position": (2.0, y),
+        "future": (2.0, future_y),
+        "intent": "stop" if stop else "keep going",
+        "case": int(case_from_ground_velocity(0.0, future_y - y)),
+        "collision": near and not stop,
+    }
+
+
+def write_dataset(folder: Path, families: dict[str, int], frames: int = 40, seed: int = 0) -> None:
+    """A dataset folder as `monopic dataset` writes it, with only what the trainer reads."""
+    rng = np.random.default_rng(seed)
+    (folder / "features").mkdir(parents=True)
+    (folder / "truth").mkdir()
+    runs = []
+    for family, seeds in families.items():
+        for s in range(seeds):
+            run = f"{family}/{s:04d}-abcdef{s:02d}"
+            runs.append((run, family, 100 + s))
+            (folder / "features" / family).mkdir(exist_ok=True)
+            (folder / "truth" / family).mkdir(exist_ok=True)
+            cols = ["frameNumber", "time", "groundX", "groundY", *FEATURE_COLUMNS.values()]
+            with (folder / "features" / f"{run}.csv").open("w", newline="") as fh:
+                w = csv.writer(fh)
+                w.writerow(cols)
+                lines = []
+                for k in range(frames):
+                    r = _row(rng, slowing=k % 2 == 0, near=(k // 2) % 2 == 0)
+                    t = round(k / 15, 6)
+                    feats = [r["values"][a] for a in FEATURE_COLUMNS]
+                    w.writerow([k, f"{t:.6f}", *r["position"], *feats])
+                    lines.append(
+                        json.dumps(
+                            {
+                                "frame": k,
+                                "time": t,
+                                "case": r["case"],
+                                "intent": r["intent"],
+                                "horizon": HORIZON,
+                                "future_position_robot": list(r["future"]),
+                                "collision": r["collision"],
+                                "robot": {
+                                    "length": 0.8,
+                                    "width": 0.6,
+                                    "speed": ROBOT_SPEED,
+                                    "yaw_rate": 0.0,
+                                },
+                            }
+                        )
+                    )
+            (folder / "truth" / f"{run}.jsonl").write_text("\n".join(lines) + "\n")
+    with (folder / "runs.csv").open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow(["run", "family", "kind", "scale", "parameters", "seed"])
+        for run, family, s in runs:
+            w.writerow([run, family, "near-miss", "small", "{}", s])
+
+
+@pytest.fixture(scope="module")
+def dataset(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    folder = tmp_path_factory.mktemp("intent") / "data"
+    write_dataset(folder, {"kerb-a": 4, "kerb-b": 4})
+    return folder
+
+
+def ground_features(values: dict[str, float], position: tuple[float, float]) -> Features:
+    g = GroundFeatures(
+        position=position,
+        velocity=(values["forward"], values["left"]),
+        camera=CAM,
+        speed=values["speed"],
+        acceleration=values["acceleration"],
+        heading_rate=values["heading_rate"],
+        path_offset=values["path_offset"],
+        path_distance=values["path_distance"],
+    )
+    return Features(
+        1.0, (400.0, 300.0), (400.0, 380.0), 160.0, values["phi"], 0.0, 0.0, g,
+        phi_rate=values["phi_rate"], head_yaw=values["head_yaw"],
+    )  # fmt: skip
+
+
+def test_the_trainer_learns_slowing_near_the_kerb_means_stop(dataset: Path) -> None:
+    runs = read_dataset(dataset)
+    assert len(runs) == 8 and all(len(r.rows) == 40 for r in runs)
+    split = split_runs(runs)
+    result = train_intent_tree(runs, split)
+    model = result.model
+    assert model.tree.root.attribute in ("acceleration", "path_distance", "path_offset")
+    predictor = IntentTreePredictor(model)
+    rng = np.random.default_rng(7)
+    for slowing in (True, False):
+        for near in (True, False):
+            r = _row(rng, slowing, near)
+            d = predictor.decide(ground_features(r["values"], r["position"]), HORIZON)
+            assert d.reading.intent == ("stop" if slowing and near else "keep going")
+            assert d.reading.support == 1.0
+            err = math.hypot(d.point[0] - r["future"][0], d.point[1] - r["future"][1])
+            assert err < 0.2, (slowing, near, d)
+    # Holding back on stop removes constant velocity's false warnings with no new miss.
+    assert model.rules.hold_back_support <= 1.0
+    assert "Split by (family, seed)" in result.report
+
+
+def _runs(groups: list[tuple[str, int]]) -> list[RunRows]:
+    return [RunRows(f"{f}/{s}", f, s, (), 1.0) for f, s in groups]
+
+
+def test_the_split_never_trains_on_an_excluded_family_and_keeps_groups_whole() -> None:
+    groups = [(f, s) for f in ("cpna", "kerb", "turn", "wait") for s in range(6)]
+    runs = _runs(groups + [("kerb", 0)])  # a (family, seed) group of two runs
+    split = split_runs(runs, 0.3, excluded_families=["wait"])
+    train = {r.group for r in split.train}
+    val = {r.group for r in split.validation}
+    assert not train & val and train and val
+    assert all(f != "wait" for f, _ in train | val)
+    assert {r.family for r in split.excluded} == {"wait"}
+    assert len(split.train) + len(split.validation) + len(split.excluded) == len(runs)
+    named = split_runs(runs, validation_families=["turn"], excluded_families=["wait"])
+    assert {r.family for r in named.validation} == {"turn"}
+    assert {r.family for r in named.train} == {"cpna", "kerb"}
+    with pytest.raises(UserError, match="'walk' is in no dataset"):
+        split_runs(runs, excluded_families=["walk"])
+    with pytest.raises(UserError, match="both validated on and excluded"):
+        split_runs(runs, validation_families=["kerb"], excluded_families=["kerb"])
+
+
+def leaf_model(label: str, n: int, rules: IntentRules, mean=(0.0, 0.0)) -> IntentTreeModel:
+    disc = Discretiser("one", tuple((a, CutPointBins(())) for a in INTENT_ATTRIBUTES))
+    root = Node(label=label, counts=((label, n),), mean=mean)
+    tree = DecisionTree(INTENT_ATTRIBUTES, root)
+    return IntentTreeModel(1.0, disc, tree, rules, 0.0, ())
+
+
+WALK_IN = {
+    "forward": 0.0, "left": SPEED, "speed": SPEED, "acceleration": -1.2, "heading_rate": 0.0,
+    "phi": 90.0, "phi_rate": 0.0, "head_yaw": 0.0, "path_offset": -1.0, "path_distance": 0.7,
+}  # fmt: skip
+
+
+def test_the_predictor_holds_back_on_a_stop_leaf_and_the_warning_follows() -> None:
+    on = IntentRules(hold_back_support=0.8, min_rows=20)
+    f = ground_features(WALK_IN, (2.0, -1.0))
+    held = IntentTreePredictor(leaf_model("6/stop", 30, on)).predict(f, 1.0)
+    assert held.ground == (2.0, -1.0) and held.case is Case.PERPENDICULAR_LEFT
+    plain = IntentTreePredictor(leaf_model("6/stop", 30, IntentRules())).predict(f, 1.0)
+    assert plain.ground == pytest.approx((2.0, -1.0 + SPEED))  # rule off: constant velocity
+    few = IntentTreePredictor(leaf_model("6/stop", 19, on)).predict(f, 1.0)
+    assert few.ground == pytest.approx((2.0, -1.0 + SPEED))  # too little support
+    warning = CollisionWarning(RobotGeometry(front=0.4))
+    ego = EgoState(CAM, speed=ROBOT_SPEED)
+    assert warning.assess(f, plain, Mode.GROUND, (768, 432), ego).collision
+    assert not warning.assess(f, held, Mode.GROUND, (768, 432), ego).collision
+
+
+def test_turn_away_drops_the_motion_toward_the_path_and_start_crossing_adds_it() -> None:
+    on = IntentRules(hold_back_support=0.8, warn_support=0.8, min_rows=5, start_speed=1.0)
+    f = ground_features(WALK_IN, (2.0, -1.0))
+    turn = IntentTreePredictor(leaf_model("8/turn away", 10, on, mean=(0.5, -0.2)))
+    d = turn.decide(f, 1.0)
+    assert d.action is Action.HOLD_TURN and d.point == pytest.approx((2.5, -1.0))
+    standing = dict(WALK_IN, left=0.0, speed=0.0)
+    g = ground_features(standing, (3.0, 1.5))  # left of the path: toward it is -y
+    start = IntentTreePredictor(leaf_model("9/start crossing", 10, on)).decide(g, 1.0)
+    assert start.action is Action.EARLIER and start.point == pytest.approx((3.0, 0.5))
+    off = IntentTreePredictor(leaf_model("9/start crossing", 10, IntentRules(min_rows=5)))
+    assert off.decide(g, 1.0).point == pytest.approx((3.0, 1.5))
+    # On the centre line there is no "toward": start crossing adds nothing, turn away
+    # drops all lateral motion (any of it counts as away, as the labels say).
+    centre = ground_features(standing, (3.0, 0.0))
+    on_line = IntentTreePredictor(leaf_model("9/start crossing", 10, on)).decide(centre, 1.0)
+    assert on_line.action is Action.NONE and on_line.point == pytest.approx((3.0, 0.0))
+    walking = ground_features(WALK_IN, (3.0, 0.0))
+    assert turn.decide(walking, 1.0).point == pytest.approx((3.5, 0.0))
+
+
+def test_operation_counts_are_counted_as_run_and_bounded_by_the_worst_case() -> None:
+    on = IntentRules(hold_back_support=0.8, warn_support=0.8, min_rows=5)
+    model = leaf_model("9/start crossing", 10, on)
+    g = ground_features(dict(WALK_IN, left=0.0, speed=0.0), (3.0, -1.5))
+    d = IntentTreePredictor(model).decide(g, 1.0)
+    assert d.action is Action.EARLIER
+    worst = worst_case_ops(model)
+    assert d.ops.total == worst.total  # this input takes the dearest path
+    assert d.placement_ops.comparisons == 11 and d.placement_ops.arithmetic == 14
+    plain = IntentTreePredictor(leaf_model("6/keep going", 10, on)).decide(g, 1.0)
+    assert plain.ops.total < worst.total
+
+
+def test_a_tree_file_round_trips_and_old_files_still_load(dataset: Path, tmp_path: Path) -> None:
+    runs = read_dataset(dataset)
+    model = train_intent_tree(runs, split_runs(runs)).model
+    path = tmp_path / "ground.json"
+    save_model(model, path)
+    again = load_intent_model(path)
+    assert again == model
+    assert json.loads(path.read_text())["version"] == 3
+    assert load_default_model().mode is Mode.IMAGE  # the shipped version-1 tree
+    with pytest.raises(
+        UserError, match="ground intent tree .* use it with predictor 'intent-tree'"
+    ):
+        load_model(path)
+    shipped = Path(__file__).parents[2] / "monopic" / "tree" / "default_tree.json"
+    with pytest.raises(UserError, match="not a ground intent tree"):
+        load_intent_model(shipped)
+
+
+def test_train_and_show_commands(
+    dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "trees" / "ground.json"
+    argv = ["tree", "train", "--mode", "ground", str(dataset), "--out", str(out)]
+    assert main([*argv, "--exclude-family", "kerb-b"]) == 0
+    text = capsys.readouterr().out
+    assert "excluded" in text and "wrote" in text
+    model = load_intent_model(out)
+    split = model.provenance["split"]
+    assert not any(r.startswith("kerb-b/") for r in split["train"] + split["validation"])
+    assert all(r.startswith("kerb-b/") for r in split["excluded"]) and split["excluded"]
+    assert main(["tree", "show", str(out)]) == 0
+    assert "ID3 intent tree, ground mode" in capsys.readouterr().out
+    assert main(["tree", "show", str(out), "--dot"]) == 0
+    assert capsys.readouterr().out.startswith("digraph")
+
+
+def one_line_error(capsys: pytest.CaptureFixture[str]) -> str:
+    err = capsys.readouterr().err.strip()
+    assert err and "\n" not in err, err
+    return err
+
+
+def _train(folder: Path, tmp_path: Path) -> list[str]:
+    return ["tree", "train", "--mode", "ground", str(folder), "--out", str(tmp_path / "t.json")]
+
+
+def test_bad_input_is_one_line_naming_file_and_field(
+    dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    assert main(_train(tmp_path, tmp_path)) == 2
+    assert "not a dataset folder (no runs.csv)" in one_line_error(capsys)
+
+    broken = tmp_path / "broken"
+    write_dataset(broken, {"kerb-a": 2}, frames=4)
+    run = "kerb-a/0000-abcdef00"
+    features = broken / "features" / f"{run}.csv"
+    text = features.read_text()
+    features.write_text(text.replace("groundAcceleration", "groundAccel", 1))
+    assert main(_train(broken, tmp_path)) == 2
+    assert f"{features}: no column 'groundAcceleration'" in one_line_error(capsys)
+
+    features.write_text(text)
+    truth = broken / "truth" / f"{run}.jsonl"
+    lines = truth.read_text().splitlines()
+    lines[2] = lines[2].replace('"intent": "', '"intent": "dawdle', 1)
+    truth.write_text("\n".join(lines) + "\n")
+    assert main(_train(broken, tmp_path)) == 2
+    assert f"{truth}: line 3: intent = 'dawdle" in one_line_error(capsys)
+
+    assert main([*_train(dataset, tmp_path), "--leaf-value", "velocity-gain"]) == 2
+    assert "--leaf-value: image mode only" in one_line_error(capsys)
+    assert not (tmp_path / "t.json").exists()
+
+
+def test_corrections_shrink_toward_constant_velocity_by_row_count() -> None:
+    from monopic.tree.intent import LeafReading, shrink_corrections
+
+    tree = leaf_model("6/stop", 30, IntentRules(), mean=(1.0, -2.0)).tree
+    half = shrink_corrections(tree, 30.0)
+    assert half.root.mean == pytest.approx((0.5, -1.0))
+    assert shrink_corrections(tree, None).root.mean == (0.0, 0.0)
+    assert shrink_corrections(tree, 0.0) == tree
+    assert LeafReading.of(half.root).intent == "stop"  # the rules read the same counts
+    with pytest.raises(ValueError, match="shrink"):
+        shrink_corrections(tree, -1.0)
