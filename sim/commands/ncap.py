@@ -3,8 +3,6 @@
 from __future__ import annotations
 
 import argparse
-import os
-import platform
 import shutil
 import time
 from pathlib import Path
@@ -173,10 +171,10 @@ def run(args: argparse.Namespace) -> int:
         name = f"matrix-{policy.replace('/', '-')}.png"
         rep.plot_matrices(protocol, points, policy, tests, args.out / name)
         pictures.append((policy, name))
-    machine = (
-        f"{platform.processor() or platform.machine()}, {os.cpu_count()} cores, "
-        f"host {platform.node()}"
-    )
+    from sim.runs.runner import machine as this_machine
+
+    m = this_machine()
+    machine = f"{m.cpu}, {m.cores} cores, host {m.host}"
     text = rep.render(
         protocol=protocol,
         car=car,

@@ -13,7 +13,6 @@ executors (sim.runs.executors: local spawned workers or Ray).
 
 from __future__ import annotations
 
-import platform
 import sys
 import time
 import traceback
@@ -26,6 +25,7 @@ from monopic.errors import UserError
 from sim.runs.aeb import AebParams, run_aeb
 from sim.runs.code_version import code_version
 from sim.runs.results_file import ResultsWriter, read_rows, scan
+from sim.runs.runner import machine
 from sim.runs.sweep import run_missing, say_skipped
 from sim.scenario.files import load
 from sim.scenario.ncap import (
@@ -142,7 +142,7 @@ def work(spec: NcapRun, kept: KeptRenderContext | None = None) -> dict[str, Any]
             **spec.meta,
             "outcome": asdict(outcome),
             "wall_s": round(time.perf_counter() - t0, 3),
-            "machine": {"host": platform.node(), "cpu": platform.processor() or "?"},
+            "machine": asdict(machine()),  # the CPU's model name, as a sweep's rows have it
         }
     except Exception:  # noqa: BLE001 - reported per run
         return {"id": spec.id, "error": traceback.format_exc()}
