@@ -189,7 +189,7 @@ class RunResult:
                 f"({'written by newer code: update this checkout' if newer else 'rerun the sweep'}"
                 " or rerun with `monopic sweep SPEC --restart`)"
             )
-        return _current_names(from_plain(cls, data, where))
+        return _behaviour_of_old_lines(_current_names(from_plain(cls, data, where)), data)
 
     def dumps(self) -> str:
         """One compact JSON line (no newline)."""
@@ -205,6 +205,19 @@ def current_key(key: str) -> str:
     """A decision key ("id3-tree/image") in today's vocabulary ("tree/image")."""
     name, slash, mode = key.partition("/")
     return f"{OLD_PREDICTOR_NAMES.get(name, name)}{slash}{mode}"
+
+
+def _behaviour_of_old_lines(result: RunResult, data: dict[str, Any]) -> RunResult:
+    """Lines written before the scenario summary named its walker model: the model the
+    sweep set (its params), when it set one, rather than the default "rail", so an older
+    human-walker sweep is not reported as rail targets. Cues are not inferred: those
+    lines predate them."""
+    summary = data.get("scenario")
+    if isinstance(summary, dict) and "behaviour" not in summary:
+        model = result.params.get("pedestrian.behaviour.model")
+        if isinstance(model, str):
+            result.scenario.behaviour = model
+    return result
 
 
 def _current_names(result: RunResult) -> RunResult:

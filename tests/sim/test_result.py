@@ -113,6 +113,20 @@ def test_a_field_added_later_loads_with_its_default_from_older_lines() -> None:
     assert back.recording is None and back.timing.sim_ms == []
 
 
+def test_lines_before_the_walker_model_was_summarised_take_the_sweeps_setting() -> None:
+    line = every_field_set().to_json()
+    del line["scenario"]["behaviour"], line["scenario"]["cues"]
+    line["params"] = {"pedestrian.behaviour.model": "human"}
+    back = RunResult.from_json(line)
+    assert (back.scenario.behaviour, back.scenario.cues) == ("human", False)
+    del line["params"]["pedestrian.behaviour.model"]
+    assert RunResult.from_json(line).scenario.behaviour == "rail"  # nothing set: the default
+    named = every_field_set().to_json()
+    named["scenario"]["behaviour"] = "rail"
+    named["params"] = {"pedestrian.behaviour.model": "human"}  # the summary wins when present
+    assert RunResult.from_json(named).scenario.behaviour == "rail"
+
+
 def test_lines_of_older_code_read_in_the_registry_vocabulary() -> None:
     """The ID3 tree was 'id3-tree' in results before its registry name 'tree' became the
     only name: such lines read as tree/image, so no report shows both names."""
