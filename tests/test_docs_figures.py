@@ -22,7 +22,7 @@ def test_the_run_counts_in_scenarios_readme_are_the_specs_own(name: str) -> None
 def test_both_readmes_quote_the_same_sweep_times_and_sizes() -> None:
     minutes = re.findall(r"(\d+) min\s+on 2 cores", SCENARIOS_README)
     assert len(minutes) == 2
-    (readme_medium,) = re.findall(r"519 runs, (\d+) min on 2 cores", README)
+    (readme_medium,) = re.findall(r"medium\.toml` \(518 runs, about (\d+) min on 2 cores", README)
     (readme_large,) = re.findall(r"large\.toml` \((\d+) runs, about (\d+) min", README)
     assert minutes == [readme_medium, readme_large[1]]
     (large,) = re.findall(r"large\.toml \((\d+) runs", SCENARIOS_README)
