@@ -85,7 +85,10 @@ def test_braking_on_the_ground_mode_warning_avoids_contacts():
     [
         (["--cases", "7"], "case 7 (toward) does not cross the path"),
         (["--cases", "5", "--policies", "brake"], "'brake' is not a policy: use none, truth"),
-        (["--cases", "5", "--policies", "id3-tree/image"], "(constant-velocity|rules|tree)"),
+        (
+            ["--cases", "5", "--policies", "id3-tree/image"],
+            "(constant-velocity|intent-tree|rules|tree)",
+        ),
         (["--cases", "5", "--policies", "rules/sky"], "'rules/sky' is not a policy"),
         (["--cases", "5", "--speeds", "fast"], "--speeds: expected numbers"),
     ],
