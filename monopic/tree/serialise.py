@@ -48,6 +48,14 @@ def model_to_json(model: TreeModel) -> dict[str, Any]:
         "mode": model.mode.value,
         "horizon_s": model.horizon,
         "displacement_unit": model.displacement_unit,
+        **_learnt(model),
+    }
+
+
+def _learnt(model: TreeModel | IntentTreeModel) -> dict[str, Any]:
+    """The fields every tree file ends with, in this order: how its inputs were binned,
+    what the learner found at the root, what it was trained on, and the tree itself."""
+    return {
         "discretiser": model.discretiser.to_json(),
         "root_entropy": model.root_entropy,
         "root_gains": [[a, g] for a, g in model.root_gains],
@@ -119,11 +127,7 @@ def intent_model_to_json(model: IntentTreeModel) -> dict[str, Any]:
         "displacement_unit": "metre",
         "labels": "case/intent",
         "intent_rules": model.rules.to_json(),
-        "discretiser": model.discretiser.to_json(),
-        "root_entropy": model.root_entropy,
-        "root_gains": [[a, g] for a, g in model.root_gains],
-        "provenance": model.provenance,
-        "tree": model.tree.to_json(),
+        **_learnt(model),
     }
 
 
