@@ -462,29 +462,16 @@ def train_intent_tree(
                     for s, rd in zip(val, readings, strict=True)
                 ]
                 options.append((rules, count_warnings(points, val_rows, horizon)))
+    # Fewest false alarms among the rules that miss no more than constant velocity; if none
+    # does, fewest misses. Ties: the stricter supports, then the lower start speed.
     feasible = [o for o in options if o[1].misses <= cv_count.misses]
-    if feasible:
-        rules, count = min(
-            feasible,
-            key=lambda o: (
-                o[1].false_alarms,
-                o[1].misses,
-                -o[0].hold_back_support,
-                -o[0].warn_support,
-                o[0].start_speed,
-            ),
-        )
-    else:
-        rules, count = min(
-            options,
-            key=lambda o: (
-                o[1].misses,
-                o[1].false_alarms,
-                -o[0].hold_back_support,
-                -o[0].warn_support,
-                o[0].start_speed,
-            ),
-        )
+
+    def order(o: tuple[IntentRules, Any]) -> tuple[float, ...]:
+        rule, c = o
+        first = (c.false_alarms, c.misses) if feasible else (c.misses, c.false_alarms)
+        return (*first, -rule.hold_back_support, -rule.warn_support, rule.start_speed)
+
+    rules, count = min(feasible or options, key=order)
     provenance = {
         "trained_by": "monopic tree train --mode ground",
         "datasets": list(sources),
