@@ -63,8 +63,13 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-class Terminated(Exception):
-    """SIGTERM, raised so that cleanup (stopping workers, closing files) runs as on Ctrl-C."""
+class Terminated(BaseException):
+    """SIGTERM, raised so that cleanup (stopping workers, closing files) runs as on Ctrl-C.
+
+    A BaseException, as KeyboardInterrupt is: an `except Exception` that wraps errors (the
+    renderer's "cannot create a GL context", a run's failure record) must not swallow a stop
+    that lands inside it.
+    """
 
 
 def _terminate(signum: int, frame: object) -> None:

@@ -403,6 +403,18 @@ def test_sdl_catches_sigterm_unless_the_worker_environment_says_not_to(
     assert result.stdout.strip() == caught, result.stderr[-500:]
 
 
+def test_a_stop_inside_an_except_exception_block_is_not_swallowed() -> None:
+    # The renderer wraps any Exception from making a GL context as "cannot create an
+    # offscreen OpenGL context": a SIGTERM landing there ended the closed loop with exit 1.
+    from monopic.cli.main import Terminated, _terminate
+
+    with pytest.raises(Terminated):
+        try:
+            _terminate(signal.SIGTERM, None)
+        except Exception:  # noqa: BLE001 - what the wrappers do
+            pytest.fail("the stop was caught as an error")
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize(("sig", "code", "word"), SIGNALS)
 def test_dataset_and_closed_loop_stop_within_seconds_with_their_line(
