@@ -63,8 +63,12 @@ TRUTH_KEYS = ("frame", "time", "case", "intent", "future_position_robot", "colli
 BINNINGS = ("mdl", "q2", "q3", "q4")
 DEPTHS = (1, 2, 3, 4, 6)
 SHRINKS: tuple[float | None, ...] = (0.0, 20.0, 100.0, None)  # None: constant velocity's point
-SUPPORTS = (0.5, 0.6, 0.7, 0.8, 0.9, 1.01)  # 1.01: the rule off
+# The rules' thresholds tried on validation (1.01: the rule off). Hold back reads the
+# share of stop + turn away rows, which is small even where a stop is likely.
+HOLD_SHARES = (0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8, 1.01)
+WARN_SHARES = (0.3, 0.5, 0.7, 0.9, 1.01)
 START_SPEEDS = (0.6, 1.0, 1.4)
+RULE_ROWS = (20, 50, 100, 200, 400)  # min_rows: how many rows the rule node must hold
 DEFAULT_MIN_SAMPLES = 20
 
 
@@ -77,6 +81,8 @@ class LabelledRow:
     robot: RobotGeometry
     robot_speed: float
     robot_yaw_rate: float
+    time: float = math.nan  # s into the run
+    on_course: bool = False  # the truth has a contact ahead (a collision course)
 
 
 @dataclass(frozen=True)
@@ -88,10 +94,21 @@ class RunRows:
     seed: int
     rows: tuple[LabelledRow, ...]
     horizon: float
+    kind: str = ""  # the family's kind: "collision" or "near-miss" (runs.csv)
+    contact_time: float | None = None  # s, when the footprints first meet (None: never)
 
     @property
     def group(self) -> tuple[str, int]:
         return (self.family, self.seed)
+
+    @property
+    def collision_run(self) -> bool:
+        """As the sweep's metrics count it: at least one frame with contact ahead."""
+        return any(row.collision for row in self.rows)
+
+    @property
+    def near_miss(self) -> bool:
+        return self.kind == "near-miss" and not self.collision_run
 
 
 def _number(text: str, where: str, column: str) -> float:
@@ -126,7 +143,16 @@ def read_dataset(folder: Path) -> list[RunRows]:
             raise UserError(
                 f"{runs_csv}: line {line}: seed = {entry['seed']!r}: not an integer"
             ) from None
-        out.append(_read_run(folder, entry["run"], entry["family"], seed))
+        contact = (entry.get("contact_time") or "").strip()
+        where = f"{runs_csv}: line {line}"
+        run = _read_run(folder, entry["run"], entry["family"], seed)
+        out.append(
+            replace(
+                run,
+                kind=entry.get("kind") or "",
+                contact_time=_number(contact, where, "contact_time") if contact else None,
+            )
+        )
     return out
 
 
@@ -213,6 +239,8 @@ def _read_run(folder: Path, run: str, family: str, seed: int) -> RunRows:
                     ),
                     robot_speed=float(robot["speed"]),
                     robot_yaw_rate=float(robot["yaw_rate"]),
+                    time=when,
+                    on_course=t.get("time_to_collision") is not None,
                 )
             )
     if len(horizons) > 1:
@@ -364,22 +392,105 @@ class WarningCount:
         )
 
 
-def count_warnings(
+def warned_frames(
     points: Sequence[tuple[float, float]], rows: Sequence[LabelledRow], horizon: float
-) -> WarningCount:
+) -> list[bool]:
     """The ground warning (swept footprint, as monopic.variants.warning) on each row."""
-    misses = false_alarms = collisions = 0
-    for point, row in zip(points, rows, strict=True):
-        warned = (
-            meets_swept_footprint(
-                row.sample.position, point, row.robot, row.robot_speed, row.robot_yaw_rate, horizon
-            )
-            is not None
+    return [
+        meets_swept_footprint(
+            row.sample.position, point, row.robot, row.robot_speed, row.robot_yaw_rate, horizon
         )
+        is not None
+        for point, row in zip(points, rows, strict=True)
+    ]
+
+
+def count_warnings(warned: Sequence[bool], rows: Sequence[LabelledRow]) -> WarningCount:
+    """Frame-level counts of the warnings `warned` (one per row) against the truth."""
+    misses = false_alarms = collisions = 0
+    for w, row in zip(warned, rows, strict=True):
         collisions += row.collision
-        misses += row.collision and not warned
-        false_alarms += warned and not row.collision
+        misses += row.collision and not w
+        false_alarms += w and not row.collision
     return WarningCount(misses, false_alarms, collisions, len(rows))
+
+
+@dataclass(frozen=True)
+class RunCount:
+    """Run-level warnings on validation runs, counted as the sweep's metrics count them.
+
+    A collision run is warned a second ahead when its first warning while on a collision
+    course comes at least LEAD_GOAL_S before contact; a near-miss run is warned when any
+    of its frames warns. These are the issue's goals, so the rules are chosen on them.
+    """
+
+    collision_runs: int
+    warned_1s: int
+    near_miss_runs: int
+    near_miss_warned: int
+
+    def describe(self) -> str:
+        return (
+            f"{self.warned_1s}/{self.collision_runs} collision runs warned 1 s ahead, "
+            f"{self.near_miss_warned}/{self.near_miss_runs} near-miss runs warned"
+        )
+
+
+LEAD_GOAL_S = 1.0  # s: recall@1s, as sim.analysis.metrics counts it
+
+
+def count_runs(warned: Sequence[bool], runs: Sequence[RunRows]) -> RunCount:
+    """`warned` holds one flag per row of `runs`, in order."""
+    rows = sum(len(run.rows) for run in runs)
+    if rows != len(warned):
+        raise ValueError(f"{len(warned)} flags for {rows} rows")
+    collision_runs = warned_1s = near_miss_runs = near_miss_warned = 0
+    k = 0
+    for run in runs:
+        flags = warned[k : k + len(run.rows)]
+        k += len(run.rows)
+        if run.collision_run:
+            collision_runs += 1
+            pairs = zip(flags, run.rows, strict=True)
+            onset = next((row.time for w, row in pairs if w and row.on_course), None)
+            contact = run.contact_time
+            warned_1s += (
+                onset is not None
+                and contact is not None
+                and contact - onset >= (LEAD_GOAL_S - 1e-9)
+            )
+        elif run.near_miss:
+            near_miss_runs += 1
+            near_miss_warned += any(flags)
+    return RunCount(collision_runs, warned_1s, near_miss_runs, near_miss_warned)
+
+
+@dataclass(frozen=True)
+class RuleOption:
+    """One setting of the intent rules (with or without the leaves' corrections), judged."""
+
+    rules: IntentRules
+    shrink: float | None  # the corrections' shrinkage (None: off)
+    model: IntentTreeModel
+    frames: WarningCount
+    runs: RunCount
+
+
+def choose_rules(options: Sequence[RuleOption], cv: RunCount) -> RuleOption:
+    """Fewest near-miss runs warned among the options that warn as many collision runs a
+    second ahead as constant velocity; then fewest false and missed frames. If none does,
+    the most collision runs warned a second ahead. Ties: the stricter supports, the lower
+    start speed, corrections as chosen before corrections off (the option listed first)."""
+    feasible = [o for o in options if o.runs.warned_1s >= cv.warned_1s]
+
+    def order(item: tuple[int, RuleOption]) -> tuple[float, ...]:
+        k, o = item
+        nm, fa, miss = o.runs.near_miss_warned, o.frames.false_alarms, o.frames.misses
+        first = (nm, fa, miss) if feasible else (-o.runs.warned_1s, nm, fa, miss)
+        rule = o.rules
+        return (*first, -rule.hold_back_support, -rule.warn_support, rule.start_speed, k)
+
+    return min(enumerate(feasible or options), key=order)[1]
 
 
 @dataclass(frozen=True)
@@ -399,9 +510,10 @@ def train_intent_tree(
     binnings: Sequence[str] = BINNINGS,
     depths: Sequence[int] = DEPTHS,
     shrinks: Sequence[float | None] = SHRINKS,
-    supports: Sequence[float] = SUPPORTS,
+    hold_shares: Sequence[float] = HOLD_SHARES,
+    warn_shares: Sequence[float] = WARN_SHARES,
     start_speeds: Sequence[float] = START_SPEEDS,
-    min_rows: int = DEFAULT_MIN_SAMPLES,
+    rule_rows: Sequence[int] = RULE_ROWS,
     sources: Sequence[dict[str, Any]] = (),
 ) -> TrainResult:
     """Choose bins and depth, then the intent rules, on validation; fit on training rows."""
@@ -415,7 +527,7 @@ def train_intent_tree(
     val_rows = [row for r in split.validation for row in r.rows]
     if not train or not val:
         raise UserError(f"{len(train)} training and {len(val)} validation rows: both need some")
-    off = IntentRules(min_rows=min_rows)
+    off = IntentRules(min_rows=rule_rows[0])
     cv_median = float(np.median([cv_error(s, horizon) for s in val]))
     scored: list[tuple[Candidate, float, IntentTreeModel]] = []
     for binning in binnings:
@@ -437,9 +549,6 @@ def train_intent_tree(
             -list(shrinks).index(c[0].shrink),
         ),
     )
-    readings = [
-        LeafReading.of(best.tree.answer(best.discretiser.discretise(s.values))) for s in val
-    ]
     cv_points = [
         place(
             s.position,
@@ -451,27 +560,56 @@ def train_intent_tree(
         )[0]
         for s in val
     ]
-    cv_count = count_warnings(cv_points, val_rows, horizon)
-    options = []
-    for hold in supports:
-        for warn in supports:
-            for speed in start_speeds if warn <= 1 else start_speeds[:1]:
-                rules = IntentRules(hold, warn, min_rows, speed)
-                points = [
-                    place(s.position, s.velocity, rd, rules, horizon, horizon)[0]
-                    for s, rd in zip(val, readings, strict=True)
-                ]
-                options.append((rules, count_warnings(points, val_rows, horizon)))
-    # Fewest false alarms among the rules that miss no more than constant velocity; if none
-    # does, fewest misses. Ties: the stricter supports, then the lower start speed.
-    feasible = [o for o in options if o[1].misses <= cv_count.misses]
+    cv_warned = warned_frames(cv_points, val_rows, horizon)
+    cv_count = count_warnings(cv_warned, val_rows)
+    cv_runs = count_runs(cv_warned, split.validation)
+    # The rules are chosen with the chosen tree's corrections and, beside it, with the
+    # corrections off: a correction that brings the point nearer on median can still push
+    # it into the robot's path on a near miss, which is what the goal counts.
+    variants = [(best_cand.shrink, best)]
+    if best_cand.shrink is not None:
+        variants.append((None, replace(best, tree=shrink_corrections(best.tree, None))))
+    options: list[RuleOption] = []
+    memo: dict[tuple[int, float, float], bool] = {}
 
-    def order(o: tuple[IntentRules, Any]) -> tuple[float, ...]:
-        rule, c = o
-        first = (c.false_alarms, c.misses) if feasible else (c.misses, c.false_alarms)
-        return (*first, -rule.hold_back_support, -rule.warn_support, rule.start_speed)
+    def warned(points: Sequence[tuple[float, float]]) -> list[bool]:
+        # Most rules move few points: each (row, point) is judged once.
+        out = []
+        for i, (point, row) in enumerate(zip(points, val_rows, strict=True)):
+            key = (i, point[0], point[1])
+            if key not in memo:
+                memo[key] = warned_frames([point], [row], horizon)[0]
+            out.append(memo[key])
+        return out
 
-    rules, count = min(feasible or options, key=order)
+    for shrink, model in variants:
+        paths = [model.tree.path(model.discretiser.discretise(s.values)) for s in val]
+        for min_rows in rule_rows:
+            readings = [LeafReading.on_path(path, min_rows) for path in paths]
+            for hold in hold_shares:
+                for warn in warn_shares:
+                    for speed in start_speeds if warn <= 1 else start_speeds[:1]:
+                        rules = IntentRules(hold, warn, min_rows, speed)
+                        points = [
+                            place(s.position, s.velocity, rd, rules, horizon, horizon)[0]
+                            for s, rd in zip(val, readings, strict=True)
+                        ]
+                        flags = warned(points)
+                        options.append(
+                            RuleOption(
+                                rules,
+                                shrink,
+                                model,
+                                count_warnings(flags, val_rows),
+                                count_runs(flags, split.validation),
+                            )
+                        )
+    chosen = choose_rules(options, cv_runs)
+    rules, count, best = chosen.rules, chosen.frames, chosen.model
+    by_error = best_cand
+    if chosen.shrink != best_cand.shrink:  # the rules' stage turned the corrections off
+        best_cand = replace(best_cand, shrink=chosen.shrink)
+        best_err = float(np.median([point_error(best, s, off) for s in val]))
     provenance = {
         "trained_by": "monopic tree train --mode ground",
         "datasets": list(sources),
@@ -492,6 +630,8 @@ def train_intent_tree(
             "constant_velocity_median_error_m": cv_median,
             "warnings": count.describe(),
             "constant_velocity_warnings": cv_count.describe(),
+            "runs": chosen.runs.describe(),
+            "constant_velocity_runs": cv_runs.describe(),
         },
     }
     model = IntentTreeModel(
@@ -514,15 +654,17 @@ def train_intent_tree(
             cells = "  ".join(f"{e:>13.3f}" for e in errs)
             table.append(f"  {f'{binning}, {depth}':<12} {cells}")
     table.append(f"  constant velocity {cv_median:.3f}")
-    table.append(f"Chosen: {best_cand.describe()} ({best_err:.3f} m)")
+    table.append(f"Lowest point error: {by_error.describe()}")
     table.append(
-        "Intent rules chosen on validation: hold back at support "
-        f"{_support(rules.hold_back_support)}, "
-        f"warn earlier at {_support(rules.warn_support)} (start speed {rules.start_speed:g} m/s), "
-        f"at least {rules.min_rows} leaf rows"
+        "Intent rules chosen on validation (fewest near-miss runs warned at constant "
+        "velocity's recall@1s): hold back at a stop + turn-away share of "
+        f"{_support(rules.hold_back_support)}, warn earlier at a start-crossing share of "
+        f"{_support(rules.warn_support)} (start speed {rules.start_speed:g} m/s), read at the "
+        f"deepest node with at least {rules.min_rows} rows"
     )
-    table.append(f"  with the rules: {count.describe()}")
-    table.append(f"  constant velocity: {cv_count.describe()}")
+    table.append(f"Chosen: {best_cand.describe()} ({best_err:.3f} m)")
+    table.append(f"  with the rules: {chosen.runs.describe()}; {count.describe()}")
+    table.append(f"  constant velocity: {cv_runs.describe()}; {cv_count.describe()}")
     report = split.describe() + "\n" + "\n".join(table)
     return TrainResult(model, split, report, tuple((c, e) for c, e, _ in scored))
 

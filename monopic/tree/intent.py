@@ -10,13 +10,21 @@ splits that explain either; each leaf's counts then give both marginals exactly.
 Each node's `mean` is the mean correction to constant velocity over the model's horizon
 (metres, robot frame, forward and left): true future position minus the pipeline's own
 constant-velocity point. The prediction is constant velocity plus that correction, then
-the intent rules (IntentRules, thresholds chosen on a validation split when training):
+the intent rules (IntentRules, thresholds chosen on a validation split when training).
+They read the intent counts of the rule node: the deepest node on the row's path with at
+least min_rows rows (a leaf's few rows say little; its ancestors pool more alike rows):
 
-- stop, with support >= hold_back_support on >= min_rows rows: the point stays where the
-  person is (held back: no motion into the robot's path is predicted);
-- turn away, same support: the lateral motion toward the path's centre line is dropped;
-- start crossing, support >= warn_support on >= min_rows rows: the lateral motion toward
-  the centre line is at least start_speed x horizon (warns earlier).
+- stop or turn away together on a share >= hold_back_support of the rule node's rows,
+  stop the more common of the two: the point stays where the person is (held back: no
+  motion into the robot's path is predicted);
+- the same with turn away the more common: the lateral motion toward the path's centre
+  line is dropped;
+- otherwise start crossing on a share >= warn_support: the lateral motion toward the
+  centre line is at least start_speed x horizon (warns earlier).
+
+The shares, not the majority: a stop is rare among all rows even where it is likely,
+and the warning needs to know that it is likely, not that it is the commonest outcome.
+The case and the correction come from the leaf.
 
 The predictor sees only the feature record (never the truth); it is stateless.
 """
@@ -101,9 +109,9 @@ def intent_values(features: Features) -> dict[str, float]:
 
 @dataclass(frozen=True)
 class IntentRules:
-    """When a leaf's intent changes the predicted point (see the module docstring).
+    """When the intent counts change the predicted point (see the module docstring).
 
-    A support above 1 switches that rule off.
+    A support above 1 switches that rule off; min_rows picks the rule node.
     """
 
     hold_back_support: float = 1.01
@@ -248,27 +256,54 @@ def shrink_corrections(tree: DecisionTree, shrink: float | None) -> DecisionTree
 
 @dataclass(frozen=True)
 class LeafReading:
-    """What a node says: majority case and intent (marginals of its joint counts)."""
+    """What a row's path says: the leaf's majority case, intent and correction, and the
+    rule node's shares of the intents the rules act on (marginals of joint counts)."""
 
     case: Case
     intent: str
-    support: float  # share of the node's rows with that intent
-    rows: int
+    support: float  # share of the leaf's rows with that intent
+    rows: int  # the rule node's rows
     correction: tuple[float, float]  # m over the model's horizon (forward, left)
+    hold_share: float = 0.0  # the rule node's share of stop + turn away rows
+    hold_intent: str = "stop"  # the more common of the two there (ties: stop)
+    start_share: float = 0.0  # the rule node's share of start-crossing rows
 
     @classmethod
-    def of(cls, node: Node) -> LeafReading:
-        cases: Counter = Counter()
-        intents: Counter = Counter()
-        for lab, c in node.counts:
-            case, intent = split_label(lab)
-            cases[case] += c
-            intents[intent] += c
+    def of(cls, node: Node, rule_node: Node | None = None) -> LeafReading:
+        """`node` the leaf (or the node the row ends at), `rule_node` where the rules read."""
+        cases, intents = _marginals(node)
         n = sum(intents.values())
         case = min(cases, key=lambda k: (-cases[k], int(k)))  # ties: the smaller case
         intent = min(intents, key=lambda k: (-intents[k], INTENTS.index(k)))
+        _, at = _marginals(rule_node or node)
+        m = sum(at.values())
         assert node.mean is not None
-        return cls(case, intent, intents[intent] / n, n, (node.mean[0], node.mean[1]))
+        return cls(
+            case,
+            intent,
+            intents[intent] / n,
+            m,
+            (node.mean[0], node.mean[1]),
+            hold_share=(at["stop"] + at["turn away"]) / m,
+            hold_intent="stop" if at["stop"] >= at["turn away"] else "turn away",
+            start_share=at[START_CROSSING] / m,
+        )
+
+    @classmethod
+    def on_path(cls, path: Sequence[Node], min_rows: int) -> LeafReading:
+        """The reading of a row's path: the rules read its deepest node with min_rows rows."""
+        rule_node = next((nd for nd in reversed(path) if nd.n >= min_rows), path[0])
+        return cls.of(path[-1], rule_node)
+
+
+def _marginals(node: Node) -> tuple[Counter, Counter]:
+    cases: Counter = Counter()
+    intents: Counter = Counter()
+    for lab, c in node.counts:
+        case, intent = split_label(lab)
+        cases[case] += c
+        intents[intent] += c
+    return cases, intents
 
 
 class Action(StrEnum):
@@ -321,18 +356,15 @@ def place(
             toward = -1.0
         elif c.lt(y, 0.0):
             toward = 1.0
-        is_stop = reading.intent == "stop"
-        is_turn = reading.intent == "turn away"
-        is_start = reading.intent == START_CROSSING
-        c.comparisons += 1 + (not is_stop) + (not is_stop and not is_turn)  # intent tests
-        if (is_stop or is_turn) and not c.lt(reading.support, rules.hold_back_support):
-            if is_stop:
+        if not c.lt(reading.hold_share, rules.hold_back_support):
+            c.comparisons += 1  # which of the two
+            if reading.hold_intent == "stop":
                 px, py, action = x, y, Action.HOLD_STOP
             else:
                 arithmetic += 2  # (py - y) * toward
                 if toward == 0.0 or c.lt(0.0, (py - y) * toward):
                     py, action = y, Action.HOLD_TURN
-        elif is_start and not c.lt(reading.support, rules.warn_support):
+        elif not c.lt(reading.start_share, rules.warn_support):
             c.comparisons += 1  # toward != 0: on the centre line there is no "toward"
             if toward != 0.0:
                 reach = rules.start_speed * horizon
@@ -365,7 +397,9 @@ class IntentTreePredictor:
         path = self.model.tree.path(bins)
         node = path[-1]
         tests = len(path) - 1 if node.is_leaf else len(path)
-        reading = LeafReading.of(node)
+        # The rule node is fixed per leaf (a property of the tree, like the leaf's label),
+        # so finding it on the path costs the prediction nothing it would not store.
+        reading = LeafReading.on_path(path, self.model.rules.min_rows)
         point, action, placement = place(
             g.position, g.velocity, reading, self.model.rules, horizon, self.model.horizon
         )
@@ -380,7 +414,9 @@ class IntentTreePredictor:
 def worst_case_ops(model: IntentTreeModel) -> Ops:
     """An upper bound on one prediction: every binner at its worst, the deepest path and
     the dearest placement (a start-crossing leaf moved toward the path)."""
-    reading = LeafReading(Case.STILL, START_CROSSING, 1.0, model.rules.min_rows, (0.0, 0.0))
+    reading = LeafReading(
+        Case.STILL, START_CROSSING, 1.0, model.rules.min_rows, (0.0, 0.0), start_share=1.0
+    )
     rules = IntentRules(warn_support=1.0, min_rows=model.rules.min_rows, start_speed=1.0)
     _, _, placement = place((1.0, -1.0), (0.0, 0.0), reading, rules, 1.0, 1.0)
     return model.discretiser.worst_case_ops() + Ops(comparisons=model.tree.depth) + placement

@@ -100,7 +100,8 @@ def summary(model: TreeModel) -> str:
 def _intent_node_text(node: Node) -> str:
     r = LeafReading.of(node)
     text = (
-        f"case {int(r.case)} {r.case.label}, {r.intent} ({r.support:.0%} of n={r.rows}), "
+        f"case {int(r.case)} {r.case.label}, {r.intent} ({r.support:.0%} of n={r.rows}; "
+        f"stop or turn away {r.hold_share:.0%}, start crossing {r.start_share:.0%}), "
         f"corrects constant velocity by ({r.correction[0]:+.2f}, {r.correction[1]:+.2f}) m"
     )
     if not node.is_leaf:
@@ -148,9 +149,9 @@ def intent_summary(model: IntentTreeModel) -> str:
         f"{len(split.get('train', []))} runs, validated on {len(split.get('validation', []))}"
         f", excluded {len(split.get('excluded', []))}",
         _validation_text(val),
-        f"Intent rules: hold back at support {_support(r.hold_back_support)}, warn earlier "
-        f"at {_support(r.warn_support)}, start speed {r.start_speed:g} m/s, at least "
-        f"{r.min_rows} leaf rows",
+        f"Intent rules: hold back at a stop + turn-away share of {_support(r.hold_back_support)}"
+        f", warn earlier at a start-crossing share of {_support(r.warn_support)}, start speed "
+        f"{r.start_speed:g} m/s, read at the deepest node with at least {r.min_rows} rows",
         "",
         gain_table(model),
         "",

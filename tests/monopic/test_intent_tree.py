@@ -20,7 +20,13 @@ from monopic.frame import EgoState
 from monopic.predict.base import Mode
 from monopic.replay.intent_training import (
     FEATURE_COLUMNS,
+    LabelledRow,
+    RuleOption,
+    RunCount,
     RunRows,
+    WarningCount,
+    choose_rules,
+    count_runs,
     read_dataset,
     split_runs,
     train_intent_tree,
@@ -33,6 +39,8 @@ from monopic.tree.intent import (
     IntentRules,
     IntentTreeModel,
     IntentTreePredictor,
+    LeafReading,
+    place,
     worst_case_ops,
 )
 from monopic.tree.serialise import (
@@ -227,6 +235,32 @@ def test_the_predictor_holds_back_on_a_stop_leaf_and_the_warning_follows() -> No
     assert not warning.assess(f, held, Mode.GROUND, (768, 432), ego).collision
 
 
+def test_the_rules_read_shares_at_the_deepest_node_with_enough_rows() -> None:
+    # A leaf of 8 rows, all "keep going", under a node of 100 where a third stop or turn.
+    leaf = Node(label="6/keep going", counts=(("6/keep going", 8),), mean=(0.0, 0.0))
+    other = Node("6/keep going", (("6/keep going", 59), ("6/stop", 33)), mean=(0.0, 0.0))
+    parent = Node(
+        attribute="speed",
+        label="6/keep going",
+        counts=(("6/keep going", 67), ("6/stop", 21), ("6/turn away", 12)),
+        mean=(0.0, 0.0),
+        branches=((0, leaf), (1, other)),
+    )
+    reading = LeafReading.on_path([parent, leaf], min_rows=20)
+    assert reading.intent == "keep going" and reading.support == 1.0  # the leaf's own
+    assert reading.rows == 100 and reading.hold_share == pytest.approx(0.33)
+    assert reading.hold_intent == "stop"  # 21 stops against 12 turns
+    assert LeafReading.on_path([parent, leaf], min_rows=5).hold_share == 0.0
+    # A third is not the majority, yet holds back at a share of 0.3.
+    f = ground_features(WALK_IN, (2.0, -1.0))
+    point, action, _ = place(f.ground.position, f.ground.velocity, reading,
+                             IntentRules(hold_back_support=0.3, min_rows=20), 1.0, 1.0)  # fmt: skip
+    assert action is Action.HOLD_STOP and point == (2.0, -1.0)
+    _, action, _ = place(f.ground.position, f.ground.velocity, reading,
+                         IntentRules(hold_back_support=0.4, min_rows=20), 1.0, 1.0)  # fmt: skip
+    assert action is Action.NONE
+
+
 def test_turn_away_drops_the_motion_toward_the_path_and_start_crossing_adds_it() -> None:
     on = IntentRules(hold_back_support=0.8, warn_support=0.8, min_rows=5, start_speed=1.0)
     f = ground_features(WALK_IN, (2.0, -1.0))
@@ -256,7 +290,7 @@ def test_operation_counts_are_counted_as_run_and_bounded_by_the_worst_case() -> 
     assert d.action is Action.EARLIER
     worst = worst_case_ops(model)
     assert d.ops.total == worst.total  # this input takes the dearest path
-    assert d.placement_ops.comparisons == 11 and d.placement_ops.arithmetic == 14
+    assert d.placement_ops.comparisons == 9 and d.placement_ops.arithmetic == 14
     plain = IntentTreePredictor(leaf_model("6/keep going", 10, on)).decide(g, 1.0)
     assert plain.ops.total < worst.total
 
@@ -346,3 +380,50 @@ def test_corrections_shrink_toward_constant_velocity_by_row_count() -> None:
     assert LeafReading.of(half.root).intent == "stop"  # the rules read the same counts
     with pytest.raises(ValueError, match="shrink"):
         shrink_corrections(tree, -1.0)
+
+
+def _timed_run(kind: str, collisions: list[bool], contact: float | None) -> RunRows:
+    """A run of frames at 0.25 s steps; a frame on a collision course from its first
+    collision frame on (enough for counting: the rows' samples are never read)."""
+    first = collisions.index(True) if True in collisions else len(collisions)
+    rows = tuple(
+        LabelledRow(None, c, RobotGeometry(0.6, 0.8, 0.4), 2.0, 0.0, k * 0.25, k >= first)  # type: ignore[arg-type]
+        for k, c in enumerate(collisions)
+    )
+    return RunRows(f"f/{kind}", "f", 0, rows, 1.5, kind, contact)
+
+
+def test_run_counts_follow_the_sweep_metrics_definitions() -> None:
+    hit = _timed_run("collision", [False, False, True, True, True, True, True], 1.75)
+    near = _timed_run("near-miss", [False] * 4, None)
+    runs = [hit, near]
+    # A warning before the collision course does not count as the onset.
+    early = [True, False, False, False, False, False, False] + [False] * 4
+    assert count_runs(early, runs) == RunCount(1, 0, 1, 0)
+    # Onset at 0.5 s, contact at 1.75 s: 1.25 s ahead; at 1.0 s it is only 0.75 s ahead.
+    assert (
+        count_runs([False, False, True, False, False, False, False] + [False] * 4, runs).warned_1s
+        == 1
+    )
+    assert count_runs([False] * 4 + [True] * 3 + [False] * 4, runs).warned_1s == 0
+    # Any warning on a near miss counts it as warned.
+    assert count_runs([False] * 7 + [False, False, True, False], runs).near_miss_warned == 1
+    with pytest.raises(ValueError, match="flags for 11 rows"):
+        count_runs([True], runs)
+
+
+def test_rules_are_chosen_for_fewest_near_misses_at_the_recall_of_constant_velocity() -> None:
+    def option(hold: float, warned_1s: int, nm: int, false_alarms: int = 0) -> RuleOption:
+        return RuleOption(
+            IntentRules(hold_back_support=hold),
+            0.0,
+            None,  # type: ignore[arg-type]
+            WarningCount(0, false_alarms, 10, 100),
+            RunCount(5, warned_1s, 6, nm),
+        )
+
+    cv = RunCount(5, 4, 6, 3)
+    options = [option(1.01, 4, 3), option(0.7, 4, 1, 9), option(0.5, 3, 0), option(0.6, 4, 1, 2)]
+    assert choose_rules(options, cv).rules.hold_back_support == 0.6  # nm 1, fewer false frames
+    # When no option keeps constant velocity's recall, the one warning most runs in time.
+    assert choose_rules([option(0.5, 2, 0), option(0.7, 3, 2)], cv).rules.hold_back_support == 0.7

@@ -396,13 +396,20 @@ def test_a_bad_intent_tree_key_is_one_line(
 
 
 def test_the_judged_intent_sweep_shares_no_run_or_seed_with_the_training_data() -> None:
-    """intent-judged draws other seeds and values outside intent-train's ranges."""
+    """intent-judged draws other seeds and values outside intent-train's ranges (both halves)."""
     import tomllib
 
     from sim.runs.sweep import expand_spec, load_spec, parse_spec
     from tests.paths import SCENARIOS
 
-    train = expand_spec(load_spec(SCENARIOS / "datasets" / "intent-train.toml"))
+    halves = [
+        expand_spec(load_spec(SCENARIOS / "datasets" / name))
+        for name in ("intent-train.toml", "intent-train-b.toml")
+    ]
+    assert not {(r.family, r.scenario.seed) for r in halves[0]} & {
+        (r.family, r.scenario.seed) for r in halves[1]
+    }
+    train = halves[0] + halves[1]
     judged_path = SCENARIOS / "sweeps" / "intent-judged.toml"
     data = tomllib.loads(judged_path.read_text())
     assert data.pop("intent_tree") == "../../recordings/intent/ground.json"
