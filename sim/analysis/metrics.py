@@ -59,6 +59,35 @@ def wilson(successes: int, n: int, z: float = Z95) -> tuple[float, float]:
     return max(0.0, centre - half), min(1.0, centre + half)
 
 
+def paired_difference(
+    both: int, only_first: int, only_second: int, neither: int, z: float = Z95
+) -> tuple[float, float, float]:
+    """Difference of two paired proportions (first - second) with its 95 % interval.
+
+    Newcombe's hybrid score interval for paired data (method 10 of R. G. Newcombe,
+    "Improved confidence intervals for the difference between binomial proportions based
+    on paired data", Statistics in Medicine 17 (1998) 2635-2650): the two Wilson
+    intervals combined with the correlation of the pairs. Why paired: both methods see
+    the same runs, so a run hard for one is mostly hard for the other.
+    Returns (difference, low, high); nan when there are no pairs.
+    """
+    n = both + only_first + only_second + neither
+    if n == 0:
+        return math.nan, math.nan, math.nan
+    p1, p2 = (both + only_first) / n, (both + only_second) / n
+    l1, u1 = wilson(both + only_first, n, z)
+    l2, u2 = wilson(both + only_second, n, z)
+    margins = (both + only_first) * (only_second + neither) * (both + only_second)
+    margins *= only_first + neither
+    # The correlation of the pairs, with Newcombe's continuity correction of a positive one.
+    cross = both * neither - only_first * only_second
+    cross = cross - n / 2 if cross > n / 2 else (cross if cross < 0 else 0.0)
+    phi = cross / math.sqrt(margins) if margins else 0.0
+    low = math.sqrt(max(0.0, (p1 - l1) ** 2 - 2 * phi * (p1 - l1) * (u2 - p2) + (u2 - p2) ** 2))
+    high = math.sqrt(max(0.0, (u1 - p1) ** 2 - 2 * phi * (u1 - p1) * (p2 - l2) + (p2 - l2) ** 2))
+    return p1 - p2, p1 - p2 - low, p1 - p2 + high
+
+
 def ratio(num: float, den: float) -> float:
     return num / den if den else math.nan
 
@@ -787,3 +816,60 @@ def compute(rows: Sequence[RunResult]) -> SweepMetrics:
             m: summary for m in all_methods if (summary := intent_summary(rows, m)) is not None
         },
     )
+
+
+@dataclass(frozen=True)
+class PairedRecall:
+    """Two methods judged on the same runs: recall@1s of each on the collision runs, its
+    paired difference with Newcombe's interval, and near-miss runs warned by each."""
+
+    collision_runs: int
+    warned_1s: tuple[int, int]
+    difference: float
+    low: float
+    high: float
+    near_miss_runs: int
+    near_miss_warned: tuple[int, int]
+
+
+def paired_recall(first: Sequence[RunOutcome], second: Sequence[RunOutcome]) -> PairedRecall:
+    """`first` and `second` hold the same runs in the same order (SweepMetrics.outcomes)."""
+    if [o.id for o in first] != [o.id for o in second]:
+        raise ValueError("paired outcomes must be of the same runs in the same order")
+    cells = Counter()
+    for a, b in zip(first, second, strict=True):
+        if a.collision_run:
+            cells[(_warned_1s(a), _warned_1s(b))] += 1
+    diff, low, high = paired_difference(
+        cells[(True, True)], cells[(True, False)], cells[(False, True)], cells[(False, False)]
+    )
+    near = [(a, b) for a, b in zip(first, second, strict=True) if a.near_miss]
+    return PairedRecall(
+        collision_runs=sum(cells.values()),
+        warned_1s=(
+            cells[(True, True)] + cells[(True, False)],
+            cells[(True, True)] + cells[(False, True)],
+        ),
+        difference=diff,
+        low=low,
+        high=high,
+        near_miss_runs=len(near),
+        near_miss_warned=(sum(a.warned for a, _ in near), sum(b.warned for _, b in near)),
+    )
+
+
+def _warned_1s(o: RunOutcome) -> bool:
+    return o.lead is not None and o.lead >= LEAD_GOAL
+
+
+def paired_by_family(m: SweepMetrics, first: str, second: str) -> dict[str, PairedRecall]:
+    """paired_recall per family and over all families ("all")."""
+    a, b = m.outcomes[first], m.outcomes[second]
+    out = {
+        family: paired_recall(
+            [o for o in a if o.family == family], [o for o in b if o.family == family]
+        )
+        for family in m.families
+    }
+    out["all"] = paired_recall(a, b)
+    return out

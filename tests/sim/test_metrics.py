@@ -8,6 +8,8 @@ from pathlib import Path
 from typing import Any
 
 import pytest
+from hypothesis import given
+from hypothesis import strategies as st
 
 from monopic.cases import Case
 from sim.analysis.metrics import (
@@ -15,6 +17,7 @@ from sim.analysis.metrics import (
     case_summary,
     compute,
     judge_run,
+    paired_difference,
     position_summary,
     summarise,
     wilson,
@@ -341,3 +344,33 @@ def test_intent_summary_against_the_truth_and_constant_velocity() -> None:
     assert (s.compared, s.differing) == (6, 1)  # frame 4: 0.5 m from constant velocity
     assert s.error_m == 0.5 and s.cv_error_m == 0.0  # the truth's future is (1, 0)
     assert intent_summary([r], "constant-velocity/ground") is None  # states no intent
+
+
+counts = st.integers(min_value=0, max_value=60)
+
+
+@given(counts, counts, counts, counts)
+def test_the_paired_interval_holds_the_difference_and_turns_with_the_order(
+    both: int, first: int, second: int, neither: int
+) -> None:
+    if both + first + second + neither == 0:
+        assert all(math.isnan(v) for v in paired_difference(0, 0, 0, 0))
+        return
+    diff, low, high = paired_difference(both, first, second, neither)
+    n = both + first + second + neither
+    assert diff == pytest.approx((first - second) / n)
+    assert -1.0 - 1e-9 <= low <= diff + 1e-12 and diff - 1e-12 <= high <= 1.0 + 1e-9
+    back = paired_difference(both, second, first, neither)
+    assert back == pytest.approx((-diff, -high, -low))
+
+
+def test_the_paired_interval_narrows_with_agreement_and_with_more_runs() -> None:
+    # Discordant pairs widen it; the same split with ten times the runs narrows it.
+    _, low_agree, _ = paired_difference(10, 1, 1, 4)
+    _, low_split, _ = paired_difference(5, 6, 6, 0)
+    assert low_agree > low_split
+    _, low_many, high_many = paired_difference(100, 10, 10, 40)
+    assert high_many - low_many < 0.5 * (0 - low_agree) * 2
+    # Worked by hand for 36 both, 12 first only, 2 second only, none neither: Wilson
+    # 0.865-0.989 (48/50) and 0.626-0.857 (38/50), phi = -24 / sqrt(48 * 2 * 38 * 12).
+    assert paired_difference(36, 12, 2, 0) == pytest.approx((0.2, 0.0569, 0.3404), abs=1e-4)
