@@ -5,7 +5,13 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from monopic.cli.args import non_negative_float, output_file, positive_float, positive_int
+from monopic.cli.args import (
+    non_negative_float,
+    output_file,
+    output_folder,
+    positive_float,
+    positive_int,
+)
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
 from monopic.predict.base import Mode
@@ -26,9 +32,14 @@ from monopic.replay.training import (
     train_on_logs,
 )
 from monopic.tree.discretise import AUTHORS_DEAD_ZONE
-from monopic.tree.intent import IntentTreeModel
+from monopic.tree.intent import INTENT_ATTRIBUTES, IntentTreeModel
 from monopic.tree.report import intent_summary, intent_tree_dot, summary, tree_dot
-from monopic.tree.serialise import load_any_model, load_default_model, save_model
+from monopic.tree.serialise import (
+    load_any_model,
+    load_default_model,
+    load_intent_model,
+    save_model,
+)
 
 JUDGE_DESCRIPTION = """\
 Judge the image-mode tree at the real 1 s horizon, leave one file out: for each log, a
@@ -163,6 +174,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="ground mode: leave this family out entirely, e.g. a judged one (repeatable)",
     )
     t.add_argument(
+        "--without",
+        action="append",
+        default=[],
+        choices=INTENT_ATTRIBUTES,
+        metavar="ATTR",
+        help="ground mode: grow the tree without this feature (repeatable; e.g. the body "
+        f"features phi, phi_rate, head_yaw for a motion-only tree; one of "
+        f"{', '.join(INTENT_ATTRIBUTES)})",
+    )
+    t.add_argument(
         "--out", required=True, type=Path, metavar="TREE.json", help="the tree file to write"
     )
     add_training_options(t)
@@ -189,6 +210,33 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     j.add_argument("--out", type=Path, metavar="TABLE.md", help="also write the table here")
     j.set_defaults(func=_judge)
 
+    v = sub.add_parser(
+        "sensitivity",
+        help="replay ground trees beside constant velocity per cue setting of a dataset",
+        description="Replay constant velocity and each ground intent tree given on the "
+        "recorded features of dataset folders (no rendering): per value of each cue "
+        "parameter the runs vary, collision runs warned 1 s ahead, near-miss runs warned "
+        "and the median point error; and the runs without body cues beside the others. "
+        "Writes DIR/report.md and DIR/sensitivity.png (docs/intent/ground-tree.md).",
+    )
+    v.add_argument("data", nargs="+", type=Path, metavar="DATA", help="dataset folders")
+    v.add_argument(
+        "--tree",
+        action="append",
+        required=True,
+        metavar="NAME=TREE.json",
+        help="a ground tree to replay, under NAME (repeatable)",
+    )
+    v.add_argument(
+        "--by",
+        action="append",
+        metavar="KEY",
+        help="a run parameter to group by (repeatable; default the four cue keys: "
+        "pedestrian.behaviour.head_check_probability, head_check_lead, stop_lead, turn_lead)",
+    )
+    v.add_argument("--out", required=True, type=Path, metavar="DIR", help="the report folder")
+    v.set_defaults(func=_sensitivity)
+
     s = sub.add_parser(
         "show",
         help="print a tree file (text, gains, operation counts)",
@@ -203,6 +251,10 @@ def register(subparsers: argparse._SubParsersAction) -> None:
 def _train(args: argparse.Namespace) -> int:
     if args.mode == Mode.GROUND.value:
         return _train_ground(args)
+    if args.without:
+        raise UserError(
+            f"--without {args.without[0]}: ground mode only (the image tree reads phi, vx, vy)"
+        )
     logs = [prepare(read_log(path), velocity_window=args.velocity_window) for path in args.data]
     try:
         model = train_on_logs(logs, training_options(args))
@@ -251,7 +303,12 @@ def _train_ground(args: argparse.Namespace) -> int:
             f"run {dup!r} is in two datasets given (it could be trained on and validated)"
         )
     split = split_runs(runs, args.validation_share, args.validate_family, args.exclude_family)
-    result = train_intent_tree(runs, split, min_samples=args.min_samples, sources=sources)
+    attributes = [a for a in INTENT_ATTRIBUTES if a not in args.without]
+    if not attributes:
+        raise UserError("--without: every feature left out; the tree needs at least one")
+    result = train_intent_tree(
+        runs, split, min_samples=args.min_samples, sources=sources, attributes=attributes
+    )
     out = output_file(args.out, "--out")
     save_model(result.model, out)
     print(result.report)
@@ -284,6 +341,29 @@ def _judge(args: argparse.Namespace) -> int:
     if out is not None:
         write_text_atomically(out, table)
         print(f"\nwrote {out}")
+    return 0
+
+
+def _sensitivity(args: argparse.Namespace) -> int:
+    from monopic.replay.intent_sensitivity import CUE_KEYS, sensitivity, write
+
+    trees = {}
+    for text in args.tree:
+        name, sep, file = text.partition("=")
+        if not sep or not name or not file:
+            raise UserError(f"--tree {text!r}: give NAME=TREE.json")
+        if name in trees:
+            raise UserError(f"--tree {name}: given twice")
+        trees[name] = load_intent_model(Path(file))
+    runs = []
+    for folder in args.data:
+        if not folder.is_dir():
+            raise UserError(f"{folder}: not a dataset folder (`monopic dataset` output)")
+        runs.extend(read_dataset(folder))
+    result = sensitivity(runs, trees, args.by or CUE_KEYS)
+    out = output_folder(args.out, "--out")
+    markdown = write(result, out, [str(d) for d in args.data])
+    print(f"wrote {markdown} and {out / 'sensitivity.png'}")
     return 0
 
 

@@ -20,7 +20,7 @@ import csv
 import json
 import math
 import zlib
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -96,6 +96,7 @@ class RunRows:
     horizon: float
     kind: str = ""  # the family's kind: "collision" or "near-miss" (runs.csv)
     contact_time: float | None = None  # s, when the footprints first meet (None: never)
+    params: Mapping[str, Any] = field(default_factory=dict)  # the run's swept parameters
 
     @property
     def group(self) -> tuple[str, int]:
@@ -146,11 +147,18 @@ def read_dataset(folder: Path) -> list[RunRows]:
         contact = (entry.get("contact_time") or "").strip()
         where = f"{runs_csv}: line {line}"
         run = _read_run(folder, entry["run"], entry["family"], seed)
+        try:
+            params = json.loads(entry.get("parameters") or "{}")
+        except json.JSONDecodeError as err:
+            raise UserError(f"{where}: parameters: not valid JSON: {err.msg}") from None
+        if not isinstance(params, dict):
+            raise UserError(f"{where}: parameters: not a JSON object")
         out.append(
             replace(
                 run,
                 kind=entry.get("kind") or "",
                 contact_time=_number(contact, where, "contact_time") if contact else None,
+                params=params,
             )
         )
     return out
@@ -341,19 +349,19 @@ def quantile_cuts(values: Sequence[float], bins: int) -> tuple[float, ...]:
     return tuple(sorted({float(q) for q in qs}))
 
 
-def make_discretiser(binning: str, samples: Sequence[IntentSample]) -> Discretiser:
+def make_discretiser(
+    binning: str, samples: Sequence[IntentSample], attributes: Sequence[str] = INTENT_ATTRIBUTES
+) -> Discretiser:
     """Cut points per attribute, fitted on `samples` (training rows only)."""
-    columns = {a: [s.values[a] for s in samples] for a in INTENT_ATTRIBUTES}
+    columns = {a: [s.values[a] for s in samples] for a in attributes}
     if binning == "mdl":
         labels = [joint_label(s.case, s.intent) for s in samples]
-        return entropy_discretiser(columns, labels, INTENT_ATTRIBUTES, name="intent-mdl")  # type: ignore[arg-type]
+        return entropy_discretiser(columns, labels, tuple(attributes), name="intent-mdl")  # type: ignore[arg-type]
     if binning.startswith("q") and binning[1:].isdigit() and int(binning[1:]) >= 2:
         n = int(binning[1:])
         return Discretiser(
             name=f"intent-{binning}",
-            binners=tuple(
-                (a, CutPointBins(quantile_cuts(columns[a], n))) for a in INTENT_ATTRIBUTES
-            ),
+            binners=tuple((a, CutPointBins(quantile_cuts(columns[a], n))) for a in attributes),
         )
     raise ValueError(f"unknown binning {binning!r}: one of {', '.join(BINNINGS)}")
 
@@ -515,6 +523,7 @@ def train_intent_tree(
     start_speeds: Sequence[float] = START_SPEEDS,
     rule_rows: Sequence[int] = RULE_ROWS,
     sources: Sequence[dict[str, Any]] = (),
+    attributes: Sequence[str] = INTENT_ATTRIBUTES,
 ) -> TrainResult:
     """Choose bins and depth, then the intent rules, on validation; fit on training rows."""
     horizons = {r.horizon for r in runs if r.rows}
@@ -531,7 +540,7 @@ def train_intent_tree(
     cv_median = float(np.median([cv_error(s, horizon) for s in val]))
     scored: list[tuple[Candidate, float, IntentTreeModel]] = []
     for binning in binnings:
-        disc = make_discretiser(binning, train)
+        disc = make_discretiser(binning, train, attributes)
         for depth in depths:
             fitted = fit_intent_model(train, disc, ID3Params(min_samples, depth), horizon, off)
             for shrink in shrinks:
@@ -615,6 +624,7 @@ def train_intent_tree(
         "datasets": list(sources),
         "horizon_s": horizon,
         "min_samples": min_samples,
+        "attributes": list(attributes),
         "split": {
             "train": [r.run for r in split.train],
             "validation": [r.run for r in split.validation],

@@ -421,6 +421,14 @@ def test_the_judged_intent_sweep_shares_no_run_or_seed_with_the_training_data() 
     for key in ("scene.road.lane_width", "pedestrian.speed", "pedestrian.behaviour.stop_lead"):
         top = max(r.params[key] for r in train)
         assert min(r.params[key] for r in judged) > top, key
+    # The cue-sensitivity dataset is judged too: other seeds, the judged road and speeds.
+    sensitivity = expand_spec(load_spec(SCENARIOS / "datasets" / "intent-sensitivity.toml"))
+    assert len(sensitivity) == 7 * 32
+    assert not {(r.family, r.scenario.seed) for r in train} & {
+        (r.family, r.scenario.seed) for r in sensitivity
+    }
+    for key in ("scene.road.lane_width", "pedestrian.speed"):
+        assert min(r.params[key] for r in sensitivity) > max(r.params[key] for r in train)
     assert max(r.params["pedestrian.behaviour.head_check_probability"] for r in judged) < min(
         r.params["pedestrian.behaviour.head_check_probability"] for r in train
     )
