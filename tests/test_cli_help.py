@@ -28,7 +28,8 @@ COMMANDS = sub_parsers(build_parser())
 
 def test_every_command_is_there() -> None:
     expected = {"video", "tree", "tree train", "tree show", "tree judge", "tree sensitivity",
-                "replay", "view", "record", "sweep", "report", "dataset", "closed-loop"}  # fmt: skip
+                "replay", "view", "record", "sweep", "report", "dataset",
+                "closed-loop"}  # fmt: skip
     assert expected <= set(COMMANDS)
 
 
