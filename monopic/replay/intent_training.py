@@ -65,7 +65,7 @@ DEPTHS = (1, 2, 3, 4, 6)
 SHRINKS: tuple[float | None, ...] = (0.0, 20.0, 100.0, None)  # None: constant velocity's point
 # The rules' thresholds tried on validation (1.01: the rule off). Hold back reads the
 # share of stop + turn away rows, which is small even where a stop is likely.
-HOLD_SHARES = (0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8, 1.01)
+HOLD_SHARES = (0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8, 1.01)
 WARN_SHARES = (0.3, 0.5, 0.7, 0.9, 1.01)
 START_SPEEDS = (0.6, 1.0, 1.4)
 RULE_ROWS = (20, 50, 100, 200, 400)  # min_rows: how many rows the rule node must hold
@@ -436,6 +436,14 @@ class RunCount:
     warned_1s: int
     near_miss_runs: int
     near_miss_warned: int
+    # (family, collision runs warned 1 s ahead) for every family with collision runs
+    warned_1s_by_family: tuple[tuple[str, int], ...] = ()
+
+    def keeps_recall_of(self, other: RunCount) -> bool:
+        """Warns at least as many collision runs 1 s ahead as `other` in every family
+        (the goal is per family: a gain in one must not hide a loss in another)."""
+        mine = dict(self.warned_1s_by_family)
+        return all(mine.get(f, 0) >= n for f, n in other.warned_1s_by_family)
 
     def describe(self) -> str:
         return (
@@ -453,6 +461,7 @@ def count_runs(warned: Sequence[bool], runs: Sequence[RunRows]) -> RunCount:
     if rows != len(warned):
         raise ValueError(f"{len(warned)} flags for {rows} rows")
     collision_runs = warned_1s = near_miss_runs = near_miss_warned = 0
+    by_family: dict[str, int] = {}
     k = 0
     for run in runs:
         flags = warned[k : k + len(run.rows)]
@@ -462,15 +471,20 @@ def count_runs(warned: Sequence[bool], runs: Sequence[RunRows]) -> RunCount:
             pairs = zip(flags, run.rows, strict=True)
             onset = next((row.time for w, row in pairs if w and row.on_course), None)
             contact = run.contact_time
-            warned_1s += (
-                onset is not None
-                and contact is not None
-                and contact - onset >= (LEAD_GOAL_S - 1e-9)
-            )
+            early = onset is not None and contact is not None
+            early = early and contact - onset >= LEAD_GOAL_S - 1e-9
+            warned_1s += early
+            by_family[run.family] = by_family.get(run.family, 0) + early
         elif run.near_miss:
             near_miss_runs += 1
             near_miss_warned += any(flags)
-    return RunCount(collision_runs, warned_1s, near_miss_runs, near_miss_warned)
+    return RunCount(
+        collision_runs,
+        warned_1s,
+        near_miss_runs,
+        near_miss_warned,
+        tuple(sorted(by_family.items())),
+    )
 
 
 @dataclass(frozen=True)
@@ -486,10 +500,11 @@ class RuleOption:
 
 def choose_rules(options: Sequence[RuleOption], cv: RunCount) -> RuleOption:
     """Fewest near-miss runs warned among the options that warn as many collision runs a
-    second ahead as constant velocity; then fewest false and missed frames. If none does,
-    the most collision runs warned a second ahead. Ties: the stricter supports, the lower
-    start speed, corrections as chosen before corrections off (the option listed first)."""
-    feasible = [o for o in options if o.runs.warned_1s >= cv.warned_1s]
+    second ahead as constant velocity in every family; then fewest false and missed
+    frames. If none does, the most collision runs warned a second ahead. Ties: the
+    stricter supports, the lower start speed, corrections as chosen before corrections
+    off (the option listed first)."""
+    feasible = [o for o in options if o.runs.keeps_recall_of(cv)]
 
     def order(item: tuple[int, RuleOption]) -> tuple[float, ...]:
         k, o = item
@@ -667,7 +682,7 @@ def train_intent_tree(
     table.append(f"Lowest point error: {by_error.describe()}")
     table.append(
         "Intent rules chosen on validation (fewest near-miss runs warned at constant "
-        "velocity's recall@1s): hold back at a stop + turn-away share of "
+        "velocity's recall@1s in every family): hold back at a stop + turn-away share of "
         f"{_support(rules.hold_back_support)}, warn earlier at a start-crossing share of "
         f"{_support(rules.warn_support)} (start speed {rules.start_speed:g} m/s), read at the "
         f"deepest node with at least {rules.min_rows} rows"

@@ -406,13 +406,15 @@ def test_run_counts_follow_the_sweep_metrics_definitions() -> None:
     runs = [hit, near]
     # A warning before the collision course does not count as the onset.
     early = [True, False, False, False, False, False, False] + [False] * 4
-    assert count_runs(early, runs) == RunCount(1, 0, 1, 0)
+    assert count_runs(early, runs) == RunCount(1, 0, 1, 0, (("f", 0),))
     # Onset at 0.5 s, contact at 1.75 s: 1.25 s ahead; at 1.0 s it is only 0.75 s ahead.
     assert (
         count_runs([False, False, True, False, False, False, False] + [False] * 4, runs).warned_1s
         == 1
     )
     assert count_runs([False] * 4 + [True] * 3 + [False] * 4, runs).warned_1s == 0
+    on_time = count_runs([False, False, True, False, False, False, False] + [False] * 4, runs)
+    assert on_time.warned_1s_by_family == (("f", 1),)
     # Any warning on a near miss counts it as warned.
     assert count_runs([False] * 7 + [False, False, True, False], runs).near_miss_warned == 1
     with pytest.raises(ValueError, match="flags for 11 rows"):
@@ -420,56 +422,25 @@ def test_run_counts_follow_the_sweep_metrics_definitions() -> None:
 
 
 def test_rules_are_chosen_for_fewest_near_misses_at_the_recall_of_constant_velocity() -> None:
-    def option(hold: float, warned_1s: int, nm: int, false_alarms: int = 0) -> RuleOption:
+    def option(hold: float, a: int, b: int, nm: int, false_alarms: int = 0) -> RuleOption:
+        # a, b: collision runs warned 1 s ahead in families "a" and "b"
         return RuleOption(
             IntentRules(hold_back_support=hold),
             0.0,
             None,  # type: ignore[arg-type]
             WarningCount(0, false_alarms, 10, 100),
-            RunCount(5, warned_1s, 6, nm),
+            RunCount(10, a + b, 6, nm, (("a", a), ("b", b))),
         )
 
-    cv = RunCount(5, 4, 6, 3)
-    options = [option(1.01, 4, 3), option(0.7, 4, 1, 9), option(0.5, 3, 0), option(0.6, 4, 1, 2)]
+    cv = option(1.01, 2, 2, 3).runs
+    options = [
+        option(1.01, 2, 2, 3),
+        option(0.7, 2, 2, 1, 9),
+        option(0.5, 2, 1, 0),  # fewest near misses, but family b loses a run
+        option(0.4, 3, 1, 0),  # as many in all as constant velocity, yet b loses one
+        option(0.6, 2, 2, 1, 2),
+    ]
     assert choose_rules(options, cv).rules.hold_back_support == 0.6  # nm 1, fewer false frames
     # When no option keeps constant velocity's recall, the one warning most runs in time.
-    assert choose_rules([option(0.5, 2, 0), option(0.7, 3, 2)], cv).rules.hold_back_support == 0.7
-
-
-def test_sensitivity_replays_every_predictor_per_cue_value(
-    dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
-) -> None:
-    from monopic.replay.intent_sensitivity import sensitivity
-
-    folder = tmp_path / "sens"
-    lead = "pedestrian.behaviour.stop_lead"
-    drawn = [{lead: 0.0, "pedestrian.behaviour.turn_lead": 0.0,
-              "pedestrian.behaviour.head_check_probability": 0.0}, {lead: 0.4}]  # fmt: skip
-    write_dataset(folder, {"kerb-c": 4}, seed=3, params={"kerb-c": drawn})
-    runs = read_dataset(dataset)
-    model = train_intent_tree(runs, split_runs(runs)).model
-    judged = read_dataset(folder)
-    s = sensitivity(judged, {"full": model}, [lead])
-    assert s.predictors == ("constant velocity", "full") and s.runs == 4
-    assert set(s.by_value[lead]) == {0.0, 0.4}
-    for cells in s.by_value[lead].values():
-        # Every hand-made run has frames with contact ahead (and no contact time).
-        assert (
-            cells["full"].runs.collision_runs == 2 == cells["constant velocity"].runs.collision_runs
-        )
-        # The tree learnt that slowing near the kerb means stop; constant velocity did not.
-        full, cv = cells["full"].frames, cells["constant velocity"].frames
-        assert full.false_alarms < 0.5 * cv.false_alarms and full.misses <= cv.misses
-    assert s.body_off["full"].runs.collision_runs == 2 == s.body_on["full"].runs.collision_runs
-    tree = tmp_path / "full.json"
-    save_model(model, tree)
-    out = tmp_path / "report"
-    argv = ["tree", "sensitivity", str(folder), "--tree", f"full={tree}", "--by", lead]
-    assert main([*argv, "--out", str(out)]) == 0
-    assert (out / "sensitivity.png").stat().st_size > 0
-    assert "## Body cues off" in (out / "report.md").read_text()
-    capsys.readouterr()
-    assert main([*argv[:-2], "--by", "scene.road.lane_width", "--out", str(out)]) == 2
-    assert "--by scene.road.lane_width: no run of the data sets it" in one_line_error(capsys)
-    assert main(["tree", "sensitivity", str(folder), "--tree", str(tree), "--out", str(out)]) == 2
-    assert "give NAME=TREE.json" in one_line_error(capsys)
+    worse = [option(0.5, 1, 1, 0), option(0.7, 2, 1, 2)]
+    assert choose_rules(worse, cv).rules.hold_back_support == 0.7
