@@ -9,7 +9,11 @@ thread count does not matter here. Operation counts come from monopic/tree/opcou
 the worst case over inputs and the mean over the recorded frames. The results go to
 bench/history.jsonl (bench/history.py) unless --no-append.
 
-    .venv/bin/python bench/post_pose.py [--repeats 30] [--no-append]
+With --intent-tree FILE (a ground intent tree, `monopic tree train --mode ground`) the
+runner set is timed again with that tree added, as a sweep spec's `intent_tree` runs it,
+and the tree's operation counts (worst case and mean over the recorded frames) are added.
+
+    .venv/bin/python bench/post_pose.py [--repeats 30] [--intent-tree FILE] [--no-append]
 """
 
 from __future__ import annotations
@@ -109,9 +113,27 @@ def replay(fs, poses, predictors, ego, size) -> dict[str, float]:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--repeats", type=int, default=30, help="timed passes per predictor set")
+    ap.add_argument(
+        "--intent-tree", type=Path, help="a ground intent tree: also time the runner set with it"
+    )
     ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
     recorder = Recorder("post_pose", "Stage after pose: time and operation count")
+    sets_to_run = [
+        (label, [make_predictor(name, mode) for name, mode in names], names, with_ego)
+        for label, names, with_ego in SETS
+    ]
+    if args.intent_tree is not None:
+        label, names, with_ego = SETS[-1]
+        intent = make_predictor("intent-tree", Mode.GROUND, args.intent_tree)
+        sets_to_run.append(
+            (
+                "runner set + intent tree, ground",
+                [*(make_predictor(name, mode) for name, mode in names), intent],
+                (*names, ("intent-tree", Mode.GROUND)),
+                True,
+            )
+        )
     npy, npz = build()
     fs = load(npy, npz)
     n = len(fs)
@@ -133,8 +155,7 @@ def main() -> None:
         "| --- | ---: | ---: | ---: | ---: | ---: | ---: |",
     ]
     sets: list[dict[str, Any]] = []
-    for label, names, with_ego in SETS:
-        predictors = [make_predictor(name, mode) for name, mode in names]
+    for label, predictors, names, with_ego in sets_to_run:
         ego = ego_still if with_ego else None
         for _ in range(3):
             replay(fs, poses, predictors, ego, (w, h))
@@ -188,6 +209,20 @@ def main() -> None:
         f"| mean over the {len(feats)} recorded frames (min-max) | {mean:.1f} ({lo}-{hi}) "
         f"| {stage_mean:.1f} |",
     ]
+    intent_ops = None
+    if args.intent_tree is not None:
+        intent_ops = _intent_ops(intent, poses, fs, h, ego_still)
+        lines += [
+            "",
+            f"Operation counts of the ground intent tree `{args.intent_tree}` (the same "
+            "counting: bins, one test per node visited, placement and rules):",
+            "",
+            "| count | one prediction |",
+            "| --- | ---: |",
+            f"| worst case over inputs | {intent_ops['worst']} |",
+            f"| mean over the {intent_ops['frames']} recorded frames with a ground point "
+            f"(min-max) | {intent_ops['mean']:.1f} ({intent_ops['min']}-{intent_ops['max']}) |",
+        ]
     table = "\n".join(lines)
     print(table)
     results = {
@@ -208,8 +243,32 @@ def main() -> None:
             "mean_stage": stage_mean,
             "recorded_frames": len(feats),
         },
+        "intent_tree": None
+        if intent_ops is None
+        else {"file": str(args.intent_tree), **intent_ops},
     }
     recorder.finish(results, table, write=not args.no_append)
+
+
+def _intent_ops(intent: Any, poses: list, fs: Any, h: int, ego: EgoState) -> dict[str, Any]:
+    """Worst-case and recorded-frame operation counts of a ground intent tree."""
+    from monopic.tree.intent import worst_case_ops
+
+    counts = []
+    extractor = FeatureExtractor()
+    for i, pose in enumerate(poses):
+        if i == 0 or fs.sequence[i] != fs.sequence[i - 1]:
+            extractor = FeatureExtractor()
+        f = extractor.update(float(fs.timestamp[i]), pose, h, ego)
+        if f is not None and f.ground is not None:
+            counts.append(intent.decide(f, HORIZON).ops.total)
+    return {
+        "worst": worst_case_ops(intent.model).total,
+        "mean": float(np.mean(counts)) if counts else float("nan"),
+        "min": min(counts, default=0),
+        "max": max(counts, default=0),
+        "frames": len(counts),
+    }
 
 
 if __name__ == "__main__":

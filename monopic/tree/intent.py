@@ -378,11 +378,15 @@ def place(
 
 @dataclass(frozen=True)
 class IntentTreePredictor:
-    """The intent tree behind the `Predictor` interface (ground mode, stateless)."""
+    """The intent tree behind the `Predictor` interface (ground mode, stateless: the
+    readings it keeps are a property of the tree, worked out once per node reached)."""
 
     model: IntentTreeModel
     mode: Mode = Mode.GROUND
     name: str = "intent-tree"
+    _readings: dict[int, LeafReading] = field(
+        default_factory=dict, init=False, repr=False, compare=False
+    )
 
     def __post_init__(self) -> None:
         if self.mode is not Mode.GROUND:
@@ -399,7 +403,10 @@ class IntentTreePredictor:
         tests = len(path) - 1 if node.is_leaf else len(path)
         # The rule node is fixed per leaf (a property of the tree, like the leaf's label),
         # so finding it on the path costs the prediction nothing it would not store.
-        reading = LeafReading.on_path(path, self.model.rules.min_rows)
+        reading = self._readings.get(id(node))
+        if reading is None:
+            reading = LeafReading.on_path(path, self.model.rules.min_rows)
+            self._readings[id(node)] = reading
         point, action, placement = place(
             g.position, g.velocity, reading, self.model.rules, horizon, self.model.horizon
         )
