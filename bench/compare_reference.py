@@ -81,10 +81,13 @@ def run_worker(
     ref_python: Path,
     pin: bool,
     model: str = "full",
+    runtime: str = "cpu",
 ) -> Run:
     cmd, extra_env = worker_command(side, ref_python)
     cmd += ["--frames", str(frames), "--threads", str(threads), "--warmup", str(warmup)]
     cmd += ["--model", model]
+    if side == OURS:
+        cmd += ["--runtime", runtime]
     if pin:
         cmd.append("--pin")
     env = dict(os.environ, **extra_env)
@@ -362,6 +365,12 @@ def main() -> None:
     ap.add_argument("--threads", type=int, nargs="+", default=[1, 2])
     ap.add_argument("--warmup", type=int, default=30)
     ap.add_argument("--no-pin", action="store_true", help="do not confine workers to N cores")
+    ap.add_argument(
+        "--runtime",
+        choices=("cpu", "openvino"),
+        default="cpu",
+        help="our side's onnxruntime execution provider (monopic.pose.sessions.RUNTIMES)",
+    )
     ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
     recorder = Recorder("compare_reference", TITLE)
@@ -376,7 +385,9 @@ def main() -> None:
         for t in args.threads:
             order = sides if rnd % 2 == 0 else sides[::-1]
             for side in order:
-                run = run_worker(side, npy, t, args.warmup, ref_python, not args.no_pin)
+                run = run_worker(
+                    side, npy, t, args.warmup, ref_python, not args.no_pin, runtime=args.runtime
+                )
                 loads += [run.load_before, run.load_after]
                 col.runs.append(run)
                 print(
@@ -397,6 +408,7 @@ def main() -> None:
         "rounds": args.rounds,
         "warmup_frames": args.warmup,
         "pinned": not args.no_pin,
+        "runtime": args.runtime,
         "load_min": min(loads),
         "load_max": max(loads),
         "latency": [],
@@ -422,7 +434,7 @@ def main() -> None:
     seqs = ", ".join(fs.sequences)
     lines = [
         f"{n} frames 768x432 in {len(fs.sequences)} sequences ({seqs}); "
-        f"sides {', '.join(sides)}; "
+        f"sides {', '.join(sides)} (ours on onnxruntime's {args.runtime} execution provider); "
         f"{args.rounds} ABBA rounds per thread count, {args.warmup} warm-up frames per run; "
         f"workers pinned to N cores: {not args.no_pin}; "
         f"load average during the runs {min(loads):.1f}-{max(loads):.1f} on "

@@ -7,7 +7,7 @@ as shipped: the pruned landmark model and MediaPipe's heatmap refinement
 (monopic.pose.landmarks.refine_from_heatmap), as in the reference graph.
 
     .venv/bin/python bench/pipeline_worker.py --frames recordings/bench/frames-*.npy --threads 1
-        [--model lite|full|heavy]
+        [--model lite|full|heavy] [--runtime cpu|openvino]
 """
 
 from __future__ import annotations
@@ -36,7 +36,7 @@ class OurRunner:
 
         self._frame = Frame
         self._extractor = FeatureExtractor
-        config = TrackerConfig(threads=args.threads, model=args.model)
+        config = TrackerConfig(threads=args.threads, model=args.model, runtime=args.runtime)
         self.pipeline = Pipeline(PipelineConfig(tracker=config))
 
     def reset(self) -> None:
@@ -64,6 +64,7 @@ class OurRunner:
 
 def options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--model", choices=("lite", "full", "heavy"), default="full")
+    ap.add_argument("--runtime", choices=("cpu", "openvino"), default="cpu")
 
 
 def main() -> None:

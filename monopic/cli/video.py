@@ -19,7 +19,13 @@ from monopic.framelog import FRAME_COLUMNS, authors_finite, frame_row
 from monopic.output import atomic_path
 from monopic.overlay import draw
 from monopic.pipeline import Pipeline, PipelineConfig, Variant
-from monopic.pose.sessions import DEFAULT_LANDMARK_MODEL, LANDMARK_MODELS
+from monopic.pose.sessions import (
+    DEFAULT_LANDMARK_MODEL,
+    DEFAULT_RUNTIME,
+    LANDMARK_MODELS,
+    RUNTIMES,
+    check_runtime,
+)
 from monopic.pose.tracker import TrackerConfig
 from monopic.predict.base import Mode
 from monopic.predict.registry import make_predictor, predictor_names
@@ -83,6 +89,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="landmark model: lite, full or heavy (MediaPipe's model_complexity 0, 1, 2; "
         "default %(default)s)",
     )
+    p.add_argument(
+        "--runtime",
+        choices=list(RUNTIMES),
+        default=DEFAULT_RUNTIME,
+        help="onnxruntime execution provider for the pose models: cpu (onnxruntime's own "
+        "kernels) or openvino (Intel's, float32; the optional extra .[openvino]); "
+        "default %(default)s",
+    )
     g = p.add_argument_group("camera geometry (needed for ground mode and the projected zone)")
     g.add_argument("--fov", type=positive_float, help="vertical field of view, degrees")
     g.add_argument("--camera-height", type=positive_float, help="metres above the ground")
@@ -116,6 +130,10 @@ def run(args: argparse.Namespace) -> int:
             "(without them the run would only count the frames with a person)"
         )
     predictor = make_predictor(args.predictor, mode, args.tree)
+    try:
+        check_runtime(args.runtime)
+    except ValueError as err:
+        raise UserError(f"--runtime {args.runtime}: {err}") from None
     for option, out in (("--out", args.out), ("--csv", args.csv), ("--rrd", args.rrd)):
         if out is not None:
             output_file(out, option)
@@ -123,7 +141,7 @@ def run(args: argparse.Namespace) -> int:
         PipelineConfig(
             horizon=args.horizon,
             mode=mode,
-            tracker=TrackerConfig(threads=args.threads, model=args.model),
+            tracker=TrackerConfig(threads=args.threads, model=args.model, runtime=args.runtime),
         ),
         predictor,
     )

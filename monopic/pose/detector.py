@@ -17,7 +17,7 @@ import numpy as np
 
 from monopic.pose.anchors import INPUT_SIZE, ssd_anchor_centres
 from monopic.pose.search import Window
-from monopic.pose.sessions import DETECTOR_FILE, make_session, model_path
+from monopic.pose.sessions import DEFAULT_RUNTIME, DETECTOR_FILE, make_session, model_path
 
 MIN_SCORE = 0.5
 NMS_IOU = 0.3
@@ -35,8 +35,10 @@ class Detection:
 class PoseDetector:
     """Runs the detector on windows of a frame and returns detections in frame pixels."""
 
-    def __init__(self, threads: int = 1, min_score: float = MIN_SCORE) -> None:
-        self.session = make_session(model_path(DETECTOR_FILE), threads)
+    def __init__(
+        self, threads: int = 1, min_score: float = MIN_SCORE, runtime: str = DEFAULT_RUNTIME
+    ) -> None:
+        self.session = make_session(model_path(DETECTOR_FILE), threads, runtime=runtime)
         self.input_name = self.session.get_inputs()[0].name
         outputs = self.session.get_outputs()
         by_width = {o.shape[-1]: o.name for o in outputs}

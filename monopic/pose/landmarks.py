@@ -15,7 +15,13 @@ from dataclasses import dataclass
 import numpy as np
 
 from monopic.pose.region import DEFAULT_SCALE, Region
-from monopic.pose.sessions import DEFAULT_LANDMARK_MODEL, landmark_file, make_session, model_path
+from monopic.pose.sessions import (
+    DEFAULT_LANDMARK_MODEL,
+    DEFAULT_RUNTIME,
+    landmark_file,
+    make_session,
+    model_path,
+)
 from monopic.pose.skeleton import NUM_LANDMARKS
 
 INPUT_SIZE = 256
@@ -60,13 +66,15 @@ class Pose:
 
 
 class LandmarkModel:
-    def __init__(self, threads: int = 1, model: str = DEFAULT_LANDMARK_MODEL) -> None:
+    def __init__(
+        self, threads: int = 1, model: str = DEFAULT_LANDMARK_MODEL, runtime: str = DEFAULT_RUNTIME
+    ) -> None:
         # The three models share inputs and outputs; only size and accuracy differ.
         self.model = model
         file = landmark_file(model)
         # No spinning, even though it runs every frame: on a shared host spinning threads
         # cost far more than they save (sessions.py).
-        self.session = make_session(model_path(file), threads, spin=False)
+        self.session = make_session(model_path(file), threads, spin=False, runtime=runtime)
         self.input_name = self.session.get_inputs()[0].name
         # Outputs are told apart by shape: landmarks (1, 195), pose flag (1, 1), heatmap
         # (1, 39, 64, 64): channels first, as the converted files keep it (NOTICE.md).

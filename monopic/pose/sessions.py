@@ -6,6 +6,7 @@ core would fight, so the thread count is always explicit (sweep workers use one)
 
 from __future__ import annotations
 
+import json
 from importlib import resources
 from pathlib import Path
 
@@ -44,8 +45,49 @@ def model_path(name: str) -> Path:
     return path
 
 
-def make_session(path: Path, threads: int = 1, spin: bool = False) -> ort.InferenceSession:
-    """A CPU session using exactly `threads` intra-op threads.
+# onnxruntime's execution providers the pose models can run on, by the name commands take.
+# "cpu": onnxruntime's own CPU kernels (MLAS), always there. "openvino": Intel's OpenVINO
+# execution provider, a plug-in library for the same onnxruntime (the optional extra
+# `.[openvino]`, package onnxruntime-ep-openvino), in float32: its CPU kernels use the
+# AVX-512 depthwise convolutions MLAS lacks (docs/benchmarks.md, issue 21). Nodes it does
+# not take run on the CPU provider.
+RUNTIMES = ("cpu", "openvino")
+DEFAULT_RUNTIME = "cpu"
+OPENVINO_EP = "OpenVINOExecutionProvider"
+
+
+def check_runtime(runtime: str) -> None:
+    """ValueError (naming the choices, or the extra to install) unless `runtime` can run."""
+    if runtime not in RUNTIMES:
+        raise ValueError(f"unknown runtime {runtime!r}: choose one of {', '.join(RUNTIMES)}")
+    if runtime == "openvino":
+        _openvino_devices()
+
+
+def _openvino_devices() -> list:
+    """OpenVINO's CPU device, its plug-in registered with onnxruntime on first use."""
+    try:
+        import onnxruntime_ep_openvino as plugin
+    except ImportError:
+        raise ValueError(
+            "runtime 'openvino' needs the optional extra: pip install -e '.[openvino]'"
+        ) from None
+    if not any(d.ep_name == OPENVINO_EP for d in ort.get_ep_devices()):
+        ort.register_execution_provider_library(OPENVINO_EP, plugin.get_library_path())
+    devices = [
+        d
+        for d in ort.get_ep_devices()
+        if d.ep_name == OPENVINO_EP and d.device.type == ort.OrtHardwareDeviceType.CPU
+    ]
+    if not devices:
+        raise ValueError("runtime 'openvino': its plug-in offers no CPU device on this machine")
+    return devices
+
+
+def make_session(
+    path: Path, threads: int = 1, spin: bool = False, runtime: str = DEFAULT_RUNTIME
+) -> ort.InferenceSession:
+    """A session using exactly `threads` intra-op threads, on `runtime` (RUNTIMES).
 
     `spin` lets a multi-threaded session's idle threads spin-wait between runs. On a
     quiet host that saved the landmark model 7 % at 2 threads (7.8 vs 8.3 ms per frame,
@@ -54,9 +96,13 @@ def make_session(path: Path, threads: int = 1, spin: bool = False) -> ort.Infere
     for two sessions that take turns: each one's spinning threads then hold the cores
     the other needs (the detector ran 2x slower right after a spinning landmark
     session). One thread has no pool: nothing spins.
+
+    On "openvino" the thread count and float32 precision are OpenVINO's own settings:
+    on a CPU with AMX it would otherwise compute in bfloat16, which moves landmarks.
     """
     if threads < 1:
         raise ValueError(f"threads must be >= 1, got {threads}")
+    check_runtime(runtime)
     opts = ort.SessionOptions()
     opts.intra_op_num_threads = threads
     opts.inter_op_num_threads = 1
@@ -67,4 +113,8 @@ def make_session(path: Path, threads: int = 1, spin: bool = False) -> ort.Infere
     if threads > 1:  # smaller blocks, taken dynamically: a delayed thread does less
         opts.add_session_config_entry("session.dynamic_block_base", "4")
     opts.add_session_config_entry("session.inter_op.allow_spinning", "0")
+    if runtime == "openvino":
+        config = {"CPU": {"INFERENCE_PRECISION_HINT": "f32", "INFERENCE_NUM_THREADS": str(threads)}}
+        opts.add_provider_for_devices(_openvino_devices(), {"load_config": json.dumps(config)})
+        return ort.InferenceSession(str(path), sess_options=opts)
     return ort.InferenceSession(str(path), sess_options=opts, providers=["CPUExecutionProvider"])

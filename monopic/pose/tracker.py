@@ -27,7 +27,12 @@ from monopic.pose.filtering import LandmarkFilter
 from monopic.pose.landmarks import LandmarkModel, Pose
 from monopic.pose.region import DEFAULT_SCALE, Region
 from monopic.pose.search import GroundBand, Window, search_windows
-from monopic.pose.sessions import DEFAULT_LANDMARK_MODEL, landmark_file
+from monopic.pose.sessions import (
+    DEFAULT_LANDMARK_MODEL,
+    DEFAULT_RUNTIME,
+    check_runtime,
+    landmark_file,
+)
 
 
 @dataclass(frozen=True)
@@ -35,6 +40,8 @@ class TrackerConfig:
     threads: int = 1  # onnxruntime intra-op threads per model
     # MediaPipe's landmark model choice: "lite", "full" (its default) or "heavy".
     model: str = DEFAULT_LANDMARK_MODEL
+    # onnxruntime's execution provider for both models (monopic.pose.sessions.RUNTIMES).
+    runtime: str = DEFAULT_RUNTIME
     min_detection_score: float = 0.5
     min_pose_score: float = 0.5  # pose flag below this: person lost
     region_scale: float = DEFAULT_SCALE
@@ -57,6 +64,7 @@ class TrackerConfig:
 
     def __post_init__(self) -> None:
         landmark_file(self.model)  # an unknown name fails here, with the choices
+        check_runtime(self.runtime)
         if self.search_budget < 0 or self.search_budget == 1 and self.acquire_tiles:
             raise ValueError(
                 f"search_budget must be 0 (no limit) or >= 2 when tiles are used, "
@@ -83,8 +91,9 @@ class PoseTracker:
     config: TrackerConfig = field(default_factory=TrackerConfig)
 
     def __post_init__(self) -> None:
-        self.detector = PoseDetector(self.config.threads, self.config.min_detection_score)
-        self.landmarks = LandmarkModel(self.config.threads, self.config.model)
+        cfg = self.config
+        self.detector = PoseDetector(cfg.threads, cfg.min_detection_score, cfg.runtime)
+        self.landmarks = LandmarkModel(cfg.threads, cfg.model, cfg.runtime)
         self._region: Region | None = None
         self._next_tile = 0  # where the search resumes in the tile cascade
         self._filter = LandmarkFilter(self.config.smooth_landmarks, self.config.smooth_region)

@@ -11,6 +11,7 @@ fixture holds those, for each of the three on the same inputs.
 
 from __future__ import annotations
 
+import importlib.util
 from collections.abc import Callable
 from functools import cache
 
@@ -18,6 +19,7 @@ import numpy as np
 import onnxruntime as ort
 import pytest
 
+from monopic.pose.sessions import RUNTIMES, make_session
 from tests.paths import ROOT
 
 MODELS = ROOT / "monopic" / "pose" / "models"
@@ -54,19 +56,37 @@ def fixture() -> dict[str, np.ndarray]:
 
 
 @cache
-def session(model: str) -> ort.InferenceSession:
-    opts = ort.SessionOptions()
-    opts.intra_op_num_threads = 1
-    opts.inter_op_num_threads = 1
-    return ort.InferenceSession(
-        str(MODELS / f"{model}.onnx"), opts, providers=["CPUExecutionProvider"]
+def session(model: str, runtime: str = "cpu") -> ort.InferenceSession:
+    if runtime == "cpu":
+        opts = ort.SessionOptions()
+        opts.intra_op_num_threads = 1
+        opts.inter_op_num_threads = 1
+        return ort.InferenceSession(
+            str(MODELS / f"{model}.onnx"), opts, providers=["CPUExecutionProvider"]
+        )
+    return make_session(MODELS / f"{model}.onnx", 1, runtime=runtime)  # as the pipeline does
+
+
+# Every runtime the pipeline offers must reproduce the TFLite models within the same
+# tolerances; the optional one is skipped, saying so, where its extra is not installed.
+RUNTIME_PARAMS = [
+    pytest.param(
+        r,
+        marks=[]
+        if r == "cpu"
+        else pytest.mark.skipif(
+            importlib.util.find_spec("onnxruntime_ep_openvino") is None,
+            reason="runtime 'openvino' needs the extra: pip install -e '.[openvino]'",
+        ),
     )
+    for r in RUNTIMES
+]
 
 
 @cache
-def run(model: str, index: int) -> dict[str, np.ndarray]:
+def run(model: str, index: int, runtime: str = "cpu") -> dict[str, np.ndarray]:
     """ONNX outputs for one fixture image (batch dim dropped), subsampled like the fixture."""
-    sess = session(model)
+    sess = session(model, runtime)
     image = SCALE[model](fixture()[f"{model}.input"][index])[None]
     names = [o.name for o in sess.get_outputs()]
     outs = dict(zip(names, (o[0] for o in sess.run(names, {"image": image})), strict=True))
@@ -124,9 +144,10 @@ def test_fixture_is_meaningful(model: str) -> None:
     assert reference(model, "pose_flag", 1)[0] < 0.2
 
 
+@pytest.mark.parametrize("runtime", RUNTIME_PARAMS)
 @pytest.mark.parametrize("index", range(N_IMAGES))
-def test_detector_matches_tflite(index: int) -> None:
-    got = run(DETECTOR, index)
+def test_detector_matches_tflite(index: int, runtime: str) -> None:
+    got = run(DETECTOR, index, runtime)
     assert max_err(got["box_regressors"], reference(DETECTOR, "box_regressors", index)) <= (
         DETECTOR_BOX_TOL_PX
     )
@@ -135,19 +156,21 @@ def test_detector_matches_tflite(index: int) -> None:
     )
 
 
+@pytest.mark.parametrize("runtime", RUNTIME_PARAMS)
 @pytest.mark.parametrize("model", LANDMARKS)
 @pytest.mark.parametrize("index", range(N_IMAGES))
-def test_landmarks_match_tflite(model: str, index: int) -> None:
-    got = run(model, index)["landmarks"].reshape(39, 5)
+def test_landmarks_match_tflite(model: str, index: int, runtime: str) -> None:
+    got = run(model, index, runtime)["landmarks"].reshape(39, 5)
     ref = reference(model, "landmarks", index).reshape(39, 5)
     assert max_err(got[:, :2], ref[:, :2]) <= LANDMARK_XY_TOL_PX
     assert max_err(got[:, 2], ref[:, 2]) <= LANDMARK_Z_TOL_PX
     assert max_err(got[:, 3:], ref[:, 3:]) <= LANDMARK_VIS_TOL_LOGIT
 
 
+@pytest.mark.parametrize("runtime", RUNTIME_PARAMS)
 @pytest.mark.parametrize("model", LANDMARKS)
 @pytest.mark.parametrize("index", range(N_IMAGES))
-def test_other_landmark_outputs_match_tflite(model: str, index: int) -> None:
-    got = run(model, index)
+def test_other_landmark_outputs_match_tflite(model: str, index: int, runtime: str) -> None:
+    got = run(model, index, runtime)
     assert max_err(got["pose_flag"], reference(model, "pose_flag", index)) <= POSE_FLAG_TOL
     assert max_err(got["heatmap"], reference(model, "heatmap", index)) <= HEATMAP_TOL_LOGIT
