@@ -46,6 +46,7 @@ BODY_CUES_OFF = {
     "pedestrian.behaviour.turn_lead": 0.0,
 }  # no head checks, no head and shoulders leading turns: only slowing remains
 CONSTANT_VELOCITY = "constant velocity"
+MAX_VALUES = 12  # a key with more distinct values is drawn from a range, not swept
 
 
 @dataclass(frozen=True)
@@ -159,6 +160,12 @@ def sensitivity(
         values = sorted({v for r in runs if (v := _value(r, key)) is not None})
         if not values:
             raise UserError(f"--by {key}: no run of the data sets it (see the runs' parameters)")
+        if len(values) > MAX_VALUES:
+            raise UserError(
+                f"--by {key}: the runs take {len(values)} values of it (drawn from a range?); "
+                f"give a key swept over at most {MAX_VALUES} values, e.g. the cue keys of "
+                "scenarios/datasets/intent-sensitivity.toml"
+            )
         by_value[key] = {
             value: {
                 p.name: judge_group(p, runs, [_value(r, key) == value for r in runs])

@@ -444,3 +444,48 @@ def test_rules_are_chosen_for_fewest_near_misses_at_the_recall_of_constant_veloc
     # When no option keeps constant velocity's recall, the one warning most runs in time.
     worse = [option(0.5, 1, 1, 0), option(0.7, 2, 1, 2)]
     assert choose_rules(worse, cv).rules.hold_back_support == 0.7
+
+
+def test_sensitivity_replays_every_predictor_per_cue_value(
+    dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from monopic.replay.intent_sensitivity import sensitivity
+
+    folder = tmp_path / "sens"
+    lead = "pedestrian.behaviour.stop_lead"
+    drawn = [{lead: 0.0, "pedestrian.behaviour.turn_lead": 0.0,
+              "pedestrian.behaviour.head_check_probability": 0.0}, {lead: 0.4}]  # fmt: skip
+    write_dataset(folder, {"kerb-c": 4}, seed=3, params={"kerb-c": drawn})
+    runs = read_dataset(dataset)
+    model = train_intent_tree(runs, split_runs(runs)).model
+    judged = read_dataset(folder)
+    s = sensitivity(judged, {"full": model}, [lead])
+    assert s.predictors == ("constant velocity", "full") and s.runs == 4
+    assert set(s.by_value[lead]) == {0.0, 0.4}
+    for cells in s.by_value[lead].values():
+        # Every hand-made run has frames with contact ahead (and no contact time).
+        assert (
+            cells["full"].runs.collision_runs == 2 == cells["constant velocity"].runs.collision_runs
+        )
+        # The tree learnt that slowing near the kerb means stop; constant velocity did not.
+        full, cv = cells["full"].frames, cells["constant velocity"].frames
+        assert full.false_alarms < 0.5 * cv.false_alarms and full.misses <= cv.misses
+    assert s.body_off["full"].runs.collision_runs == 2 == s.body_on["full"].runs.collision_runs
+    tree = tmp_path / "full.json"
+    save_model(model, tree)
+    out = tmp_path / "report"
+    argv = ["tree", "sensitivity", str(folder), "--tree", f"full={tree}", "--by", lead]
+    assert main([*argv, "--out", str(out)]) == 0
+    assert (out / "sensitivity.png").stat().st_size > 0
+    assert "## Body cues off" in (out / "report.md").read_text()
+    capsys.readouterr()
+    assert main([*argv[:-2], "--by", "scene.road.lane_width", "--out", str(out)]) == 2
+    assert "--by scene.road.lane_width: no run of the data sets it" in one_line_error(capsys)
+    wide = tmp_path / "wide"
+    drawn_wide = [{lead: round(0.01 * k, 2)} for k in range(20)]
+    write_dataset(wide, {"kerb-d": 20}, seed=4, params={"kerb-d": drawn_wide})
+    wide_argv = ["tree", "sensitivity", str(wide), "--tree", f"full={tree}", "--by", lead]
+    assert main([*wide_argv, "--out", str(out)]) == 2
+    assert "the runs take 20 values of it" in one_line_error(capsys)
+    assert main(["tree", "sensitivity", str(folder), "--tree", str(tree), "--out", str(out)]) == 2
+    assert "give NAME=TREE.json" in one_line_error(capsys)
