@@ -36,6 +36,8 @@ VERSIONS = (1, 2)
 INTENT_VERSION = 3
 INTENT_LEAF_VALUE = "cv-correction"
 DEFAULT_TREE_NAME = "default_tree.json"
+# The ground intent tree shipped for the small robot's 1.5 s horizon (GROUND_TREE.md).
+GROUND_TREE_NAME = "ground_tree.json"
 
 
 def model_to_json(model: TreeModel) -> dict[str, Any]:
@@ -232,13 +234,14 @@ def tree_predictor(mode: Mode, model: Path | None = None) -> TreePredictor:
     return TreePredictor(tree)
 
 
+def shipped_ground_tree() -> Path:
+    """Path of the ground intent tree shipped inside the package (GROUND_TREE.md)."""
+    return Path(str(resources.files("monopic.tree").joinpath(GROUND_TREE_NAME)))
+
+
 def intent_tree_predictor(mode: Mode, model: Path | None = None) -> IntentTreePredictor:
-    """The `intent-tree` entry of the predictor registry: needs a ground intent tree file."""
+    """The `intent-tree` entry of the predictor registry: the given ground intent tree
+    file, or the shipped one (trained for the small robot's 1.5 s horizon)."""
     if mode is not Mode.GROUND:
         raise UserError(f"predictor 'intent-tree' predicts in ground mode only, not {mode} mode")
-    if model is None:
-        raise UserError(
-            "predictor 'intent-tree' needs a tree file (none is shipped): train one with "
-            "`monopic tree train --mode ground DATASET_DIR --out TREE.json`"
-        )
-    return IntentTreePredictor(load_intent_model(model))
+    return IntentTreePredictor(load_intent_model(model or shipped_ground_tree()))

@@ -489,3 +489,24 @@ def test_sensitivity_replays_every_predictor_per_cue_value(
     assert "the runs take 20 values of it" in one_line_error(capsys)
     assert main(["tree", "sensitivity", str(folder), "--tree", str(tree), "--out", str(out)]) == 2
     assert "give NAME=TREE.json" in one_line_error(capsys)
+
+
+def test_the_shipped_ground_tree_is_what_its_card_says() -> None:
+    """monopic/tree/ground_tree.json against monopic/tree/GROUND_TREE.md."""
+    from monopic.predict.registry import make_predictor
+    from monopic.tree.serialise import shipped_ground_tree
+
+    model = load_intent_model(shipped_ground_tree())
+    card = (shipped_ground_tree().parent / "GROUND_TREE.md").read_text()
+    p = model.provenance
+    assert model.horizon == 1.5 and "1.5 s" in card
+    assert (len(p["split"]["train"]), len(p["split"]["validation"])) == (258, 78)
+    assert "258 runs" in card and "78 runs" in card
+    assert p["chosen"] == {"binning": "mdl", "max_depth": 4, "shrink_rows": None}
+    assert (model.rules.hold_back_support, model.rules.min_rows) == (0.05, 20)
+    assert model.rules.warn_support > 1  # warn earlier: off
+    assert f"{sum(n.is_leaf for n in model.tree.nodes()):,} leaves" in card
+    assert f"{worst_case_ops(model).total} operations per prediction at worst" in card
+    assert p["validation"]["runs"].startswith("31/32") and "2/41" in p["validation"]["runs"]
+    predictor = make_predictor("intent-tree", Mode.GROUND)  # no file: the shipped tree
+    assert isinstance(predictor, IntentTreePredictor) and predictor.model.tree == model.tree
