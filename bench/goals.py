@@ -57,10 +57,17 @@ def ratio_at(threads: int) -> Callable[[dict[str, Any]], Standing | None]:
             return None
         ratio = ours["ratio_p50_x"]
         return Standing(
-            f"{ratio:.2f} ({ours['p50_ms']:.2f} vs {ref['p50_ms']:.2f} ms)", ratio <= RATIO_GOAL
+            f"{ratio:.2f} ({ours['p50_ms']:.2f} vs {ref['p50_ms']:.2f} ms){_runtime(results)}",
+            ratio <= RATIO_GOAL,
         )
 
     return read
+
+
+def _runtime(results: dict[str, Any]) -> str:
+    """' on openvino' for a run whose pose models were not on the default runtime."""
+    runtime = results.get("runtime", "cpu")
+    return "" if runtime == "cpu" else f" on {runtime}"
 
 
 def cpu_ratio(results: dict[str, Any], threads: int) -> float | None:
@@ -115,7 +122,8 @@ def scenario_fps_of(model: str) -> Callable[[dict[str, Any]], Standing | None]:
 
     def standing(results: dict[str, Any]) -> Standing | None:
         for row in results.get("scenario_runs", []):
-            if not row["ablation"] and row["shadows"] and row.get("behaviour", "rail") == model:
+            default = not row["ablation"] and row["shadows"] and row.get("runtime", "cpu") == "cpu"
+            if default and row.get("behaviour", "rail") == model:
                 return Standing(
                     f"{row['fps_median']:.1f} fps ({row['fps_min']:.1f}-{row['fps_max']:.1f} "
                     f"over {row['runs']} runs)",

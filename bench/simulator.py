@@ -16,6 +16,7 @@ reaped children). The results go to bench/history.jsonl (bench/history.py) unles
 from __future__ import annotations
 
 import argparse
+import importlib.util
 import json
 import os
 import resource
@@ -80,29 +81,31 @@ def child_render(frames: int) -> dict[str, Any]:
 
 
 def child_run(
-    frames: int, ablation: bool, shadows: bool = True, model: str = "rail"
+    frames: int, ablation: bool, shadows: bool = True, model: str = "rail", runtime: str = "cpu"
 ) -> dict[str, Any]:
     """One whole scenario through sim.runs.runner.run, after one warm-up run; frames per second.
 
     As in a sweep worker, the runs share one GL context (sim.world.render.KeptRenderContext), so
     llvmpipe's shader compilation is paid once by the warm-up, not by every run.
     """
+    from monopic.pose.tracker import TrackerConfig
     from sim.runs.run_spec import RunSpec
     from sim.runs.runner import run
     from sim.world.render import KeptRenderContext
 
+    tracker = TrackerConfig(threads=1, runtime=runtime)
     warm = RunSpec(id="warm", scenario=scenario(1, 10), ablation=ablation, stop_at_contact=False)
     results = []
     with KeptRenderContext() as kept:
         context = kept.fitting(768, 432)
-        run(warm, render_context=context)
+        run(warm, render_context=context, tracker=tracker)
         for case in RUN_CASES:
             spec = RunSpec(
                 id=f"case{case}", scenario=scenario(case, frames, shadows=shadows, model=model),
                 ablation=ablation, stop_at_contact=False,
             )  # fmt: skip
             cpu0, t0 = time.process_time(), time.perf_counter()
-            result = run(spec, render_context=context)
+            result = run(spec, render_context=context, tracker=tracker)
             wall, cpu = time.perf_counter() - t0, time.process_time() - cpu0
             results.append({"frames": result.frames, "wall_s": wall, "cpu_s": cpu})
     return {
@@ -167,6 +170,7 @@ def main() -> None:
     ap.add_argument("--shadows", type=int, default=1, help=argparse.SUPPRESS)
     ap.add_argument("--workers", type=int, default=1, help=argparse.SUPPRESS)
     ap.add_argument("--model", default="rail", help=argparse.SUPPRESS)
+    ap.add_argument("--runtime", default="cpu", help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
         if args.pin:
@@ -174,7 +178,9 @@ def main() -> None:
         if args.child == "render":
             out = child_render(args.frames)
         elif args.child == "run":
-            out = child_run(args.frames, bool(args.ablation), bool(args.shadows), args.model)
+            out = child_run(
+                args.frames, bool(args.ablation), bool(args.shadows), args.model, args.runtime
+            )
         else:
             out = child_sweep(args.frames, args.runs, args.workers)
         print(json.dumps(out))
@@ -184,11 +190,15 @@ def main() -> None:
     load0 = os.getloadavg()[0]
     start = time.perf_counter()
     render = spawn_child("render", True, frames=args.frames)
+    settings = [(0, 1, "rail", "cpu"), (0, 1, "human", "cpu"), (1, 1, "rail", "cpu")]
+    settings.append((0, 0, "rail", "cpu"))
+    if importlib.util.find_spec("onnxruntime_ep_openvino") is not None:  # the extra
+        settings += [(0, 1, "rail", "openvino"), (0, 1, "human", "openvino")]
     runs = {
-        (ab, sh, model): spawn_child(
-            "run", True, frames=args.frames, ablation=ab, shadows=sh, model=model
+        (ab, sh, model, rt): spawn_child(
+            "run", True, frames=args.frames, ablation=ab, shadows=sh, model=model, runtime=rt
         )
-        for ab, sh, model in ((0, 1, "rail"), (0, 1, "human"), (1, 1, "rail"), (0, 0, "rail"))
+        for ab, sh, model, rt in settings
     }
     sweeps = {
         w: spawn_child("sweep", False, frames=args.frames, runs=args.runs, workers=w)
@@ -234,16 +244,18 @@ def main() -> None:
         "scenario_runs": [],
         "sweeps": [],
     }
-    for (ab, sh, model), res in runs.items():
+    for (ab, sh, model, rt), res in runs.items():
         fps = sorted(x["frames"] / x["wall_s"] for x in res["runs"])
         med = statistics.median(fps)
         cpu = sum(x["cpu_s"] for x in res["runs"]) / sum(x["frames"] for x in res["runs"])
         name = "render + pipeline (5 predictors)" + (" + ground-truth-crop ablation" if ab else "")
         name += "" if sh else ", overcast (no shadow pass)"
         name += ", human walker" if model == "human" else ""
+        name += ", pose models on openvino" if rt == "openvino" else ""
         results["scenario_runs"].append(
             {
                 "name": name,
+                "runtime": rt,
                 "ablation": bool(ab),
                 "shadows": bool(sh),
                 "behaviour": model,

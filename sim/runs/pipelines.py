@@ -7,6 +7,7 @@ pose (image and ground mode side by side).
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 
 from monopic.pipeline import Pipeline, PipelineConfig
@@ -45,20 +46,25 @@ def scenario_pipeline(
 
 
 def make_pipeline(
-    scenario: Scenario, ablation: bool = False, intent_tree: Path | None = None
+    scenario: Scenario,
+    ablation: bool = False,
+    intent_tree: Path | None = None,
+    tracker: TrackerConfig | None = None,
 ) -> Pipeline:
     """All predictors on one pose, the sweep's pipeline.
 
     With `intent_tree` (a sweep spec's `intent_tree` file) the ground intent tree runs
-    too, last, so the primary predictor and the others' outputs are unchanged.
+    too, last, so the primary predictor and the others' outputs are unchanged. `tracker`
+    replaces the default one-thread tracker (the benchmarks time other runtimes with it).
 
     The ablation's tracker never detects (a threshold above any score, and no tiles so a
     failed crop costs one whole-frame pass): it only ever sees the true crop, so what it
     gets right or wrong is the pose from that crop.
     """
-    tracker = (
-        TrackerConfig(threads=1, min_detection_score=1.01, acquire_tiles=()) if ablation else None
-    )
+    if ablation:
+        tracker = replace(
+            tracker or TrackerConfig(threads=1), min_detection_score=1.01, acquire_tiles=()
+        )
     predictors = [make_predictor(name, mode) for name, mode in PREDICTORS]
     if intent_tree is not None:
         predictors.append(make_predictor(INTENT_TREE, Mode.GROUND, intent_tree))

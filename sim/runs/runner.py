@@ -19,6 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from monopic.pose.region import Region
+from monopic.pose.tracker import TrackerConfig
 from sim.runs.columns import PipelineRecorder, TruthRecorder
 from sim.runs.loop import Listener, OnBoard, Progress, StepTimes, run_loop
 from sim.runs.pipelines import make_pipeline
@@ -101,17 +102,19 @@ def run(
     spec: RunSpec,
     on_frame: Callable[[int], None] | None = None,
     render_context: RenderContext | None = None,
+    tracker: TrackerConfig | None = None,
 ) -> RunResult:
     """Run one scenario through the pipeline(s); returns its result record.
 
     A worker running many scenarios lends each the same `render_context` (sim.world.render).
+    `tracker` replaces the sweep's default tracker (bench/simulator.py times runtimes).
     """
     scenario = spec.scenario
     start = time.perf_counter()
     tree = Path(spec.intent_tree) if spec.intent_tree else None
-    onboard = [OnBoard(MAIN, make_pipeline(scenario, intent_tree=tree))]
+    onboard = [OnBoard(MAIN, make_pipeline(scenario, intent_tree=tree, tracker=tracker))]
     if spec.ablation:
-        ablation = make_pipeline(scenario, ablation=True, intent_tree=tree)
+        ablation = make_pipeline(scenario, ablation=True, intent_tree=tree, tracker=tracker)
         onboard.append(OnBoard(ABLATION, ablation, truth_region))
     truth = TruthRecorder()
     recorders = {board.name: PipelineRecorder(board.name) for board in onboard}
