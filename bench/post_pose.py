@@ -184,14 +184,7 @@ def main() -> None:
 
     tree = make_predictor("tree", Mode.IMAGE)
     assert isinstance(tree, TreePredictor)
-    feats = []
-    extractor = FeatureExtractor()
-    for i, pose in enumerate(poses):
-        if i == 0 or fs.sequence[i] != fs.sequence[i - 1]:
-            extractor = FeatureExtractor()
-        f = extractor.update(float(fs.timestamp[i]), pose, h)
-        if f is not None:
-            feats.append(f)
+    feats = recorded_features(fs, poses, h)
     worst = worst_case_prediction_ops(tree)
     mean, lo, hi = mean_prediction_ops(tree, feats, HORIZON)
     stage_mean = float(
@@ -250,18 +243,28 @@ def main() -> None:
     recorder.finish(results, table, write=not args.no_append)
 
 
-def _intent_ops(intent: Any, poses: list, fs: Any, h: int, ego: EgoState) -> dict[str, Any]:
-    """Worst-case and recorded-frame operation counts of a ground intent tree."""
-    from monopic.tree.intent import worst_case_ops
-
-    counts = []
+def recorded_features(fs, poses: list, h: int, ego: EgoState | None = None) -> list:
+    """The feature record of every frame with one, a fresh extractor per sequence."""
+    feats = []
     extractor = FeatureExtractor()
     for i, pose in enumerate(poses):
         if i == 0 or fs.sequence[i] != fs.sequence[i - 1]:
             extractor = FeatureExtractor()
         f = extractor.update(float(fs.timestamp[i]), pose, h, ego)
-        if f is not None and f.ground is not None:
-            counts.append(intent.decide(f, HORIZON).ops.total)
+        if f is not None:
+            feats.append(f)
+    return feats
+
+
+def _intent_ops(intent: Any, poses: list, fs: Any, h: int, ego: EgoState) -> dict[str, Any]:
+    """Worst-case and recorded-frame operation counts of a ground intent tree."""
+    from monopic.tree.intent import worst_case_ops
+
+    counts = [
+        intent.decide(f, HORIZON).ops.total
+        for f in recorded_features(fs, poses, h, ego)
+        if f.ground is not None
+    ]
     return {
         "worst": worst_case_ops(intent.model).total,
         "mean": float(np.mean(counts)) if counts else float("nan"),

@@ -56,10 +56,14 @@ DEFAULT_RUNTIME = "cpu"
 OPENVINO_EP = "OpenVINOExecutionProvider"
 
 
-def check_runtime(runtime: str) -> None:
-    """ValueError (naming the choices, or the extra to install) unless `runtime` can run."""
+def _known_runtime(runtime: str) -> None:
     if runtime not in RUNTIMES:
         raise ValueError(f"unknown runtime {runtime!r}: choose one of {', '.join(RUNTIMES)}")
+
+
+def check_runtime(runtime: str) -> None:
+    """ValueError (naming the choices, or the extra to install) unless `runtime` can run."""
+    _known_runtime(runtime)
     if runtime == "openvino":
         _openvino_devices()
 
@@ -102,7 +106,7 @@ def make_session(
     """
     if threads < 1:
         raise ValueError(f"threads must be >= 1, got {threads}")
-    check_runtime(runtime)
+    _known_runtime(runtime)  # the openvino branch below finds its plug-in (or says why not)
     opts = ort.SessionOptions()
     opts.intra_op_num_threads = threads
     opts.inter_op_num_threads = 1

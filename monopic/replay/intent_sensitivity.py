@@ -22,7 +22,6 @@ from typing import Any
 
 import numpy as np
 
-from monopic.cases import Case
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
 from monopic.replay.intent_training import (
@@ -31,9 +30,10 @@ from monopic.replay.intent_training import (
     WarningCount,
     count_runs,
     count_warnings,
+    predicted_point,
     warned_frames,
 )
-from monopic.tree.intent import INTENTS, IntentRules, IntentTreeModel, LeafReading, place
+from monopic.tree.intent import IntentTreeModel
 
 CUE_KEYS = (
     "pedestrian.behaviour.head_check_probability",
@@ -63,18 +63,7 @@ def replay(
 ) -> Replayed:
     """The predictor's point on each recorded row (None: constant velocity)."""
     rows = [row for r in runs for row in r.rows]
-    points = []
-    for row in rows:
-        s = row.sample
-        if model is None:
-            reading = LeafReading(Case.STILL, INTENTS[0], 1.0, 0, (0.0, 0.0))
-            rules = IntentRules()
-        else:
-            path = model.tree.path(model.discretiser.discretise(s.values))
-            reading = LeafReading.on_path(path, model.rules.min_rows)
-            rules = model.rules
-        model_horizon = horizon if model is None else model.horizon
-        points.append(place(s.position, s.velocity, reading, rules, horizon, model_horizon)[0])
+    points = [predicted_point(model, row.sample, horizon) for row in rows]
     return Replayed(name, tuple(points), tuple(warned_frames(points, rows, horizon)))
 
 

@@ -370,12 +370,30 @@ def _samples(runs: Sequence[RunRows]) -> list[IntentSample]:
     return [row.sample for r in runs for row in r.rows]
 
 
+CONSTANT_VELOCITY_READING = LeafReading(Case.STILL, INTENTS[0], 1.0, 0, (0.0, 0.0))
+RULES_OFF = IntentRules()
+
+
+def predicted_point(
+    model: IntentTreeModel | None,
+    sample: IntentSample,
+    horizon: float,
+    rules: IntentRules | None = None,
+) -> tuple[float, float]:
+    """The ground point a model predicts for a recorded row, as IntentTreePredictor places
+    it (`rules`: the model's own unless given); None: constant velocity's point."""
+    if model is None:
+        reading, rules, model_horizon = CONSTANT_VELOCITY_READING, RULES_OFF, horizon
+    else:
+        rules = rules or model.rules
+        path = model.tree.path(model.discretiser.discretise(sample.values))
+        reading, model_horizon = LeafReading.on_path(path, rules.min_rows), model.horizon
+    return place(sample.position, sample.velocity, reading, rules, horizon, model_horizon)[0]
+
+
 def point_error(model: IntentTreeModel, sample: IntentSample, rules: IntentRules) -> float:
     """Metres between the predicted and the true point a horizon later."""
-    reading = LeafReading.of(model.tree.answer(model.discretiser.discretise(sample.values)))
-    (px, py), _, _ = place(
-        sample.position, sample.velocity, reading, rules, model.horizon, model.horizon
-    )
+    px, py = predicted_point(model, sample, model.horizon, rules)
     return math.hypot(px - sample.future[0], py - sample.future[1])
 
 
@@ -573,17 +591,7 @@ def train_intent_tree(
             -list(shrinks).index(c[0].shrink),
         ),
     )
-    cv_points = [
-        place(
-            s.position,
-            s.velocity,
-            LeafReading(Case.STILL, INTENTS[0], 1.0, 0, (0.0, 0.0)),
-            off,
-            horizon,
-            horizon,
-        )[0]
-        for s in val
-    ]
+    cv_points = [predicted_point(None, s, horizon) for s in val]
     cv_warned = warned_frames(cv_points, val_rows, horizon)
     cv_count = count_warnings(cv_warned, val_rows)
     cv_runs = count_runs(cv_warned, split.validation)
