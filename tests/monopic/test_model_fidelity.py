@@ -11,7 +11,6 @@ fixture holds those, for each of the three on the same inputs.
 
 from __future__ import annotations
 
-import importlib.util
 from collections.abc import Callable
 from functools import cache
 
@@ -19,7 +18,7 @@ import numpy as np
 import onnxruntime as ort
 import pytest
 
-from monopic.pose.sessions import RUNTIMES, make_session
+from monopic.pose.sessions import RUNTIMES, make_session, runtime_unavailable
 from tests.paths import ROOT
 
 MODELS = ROOT / "monopic" / "pose" / "models"
@@ -75,8 +74,7 @@ RUNTIME_PARAMS = [
         marks=[]
         if r == "cpu"
         else pytest.mark.skipif(
-            importlib.util.find_spec("onnxruntime_ep_openvino") is None,
-            reason="runtime 'openvino' needs the extra: pip install -e '.[openvino]'",
+            runtime_unavailable(r) is not None, reason=str(runtime_unavailable(r))
         ),
     )
     for r in RUNTIMES

@@ -5,7 +5,6 @@ And its landmark filtering across frames: on with timestamps, restarted with eac
 
 from __future__ import annotations
 
-import importlib.util
 import math
 from dataclasses import replace
 
@@ -19,6 +18,7 @@ from monopic.pose.filtering import LandmarkFilter
 from monopic.pose.landmarks import LandmarkModel, Pose
 from monopic.pose.region import Region
 from monopic.pose.search import tile_windows
+from monopic.pose.sessions import runtime_unavailable
 from monopic.pose.tracker import PoseTracker, TrackerConfig
 from monopic.video import VideoSource
 from tests.monopic.test_end_to_end import CLIP
@@ -267,8 +267,7 @@ def test_an_unknown_landmark_model_is_refused_with_the_choices():
 
 
 @pytest.mark.skipif(
-    importlib.util.find_spec("onnxruntime_ep_openvino") is None,
-    reason="runtime 'openvino' needs the extra: pip install -e '.[openvino]'",
+    runtime_unavailable("openvino") is not None, reason=str(runtime_unavailable("openvino"))
 )
 def test_the_openvino_runtime_gives_the_cpu_runtimes_landmarks_on_the_clip():
     """The same crops, the same landmarks: OpenVINO computes in float32 (no bfloat16 on
