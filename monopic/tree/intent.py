@@ -22,6 +22,14 @@ least min_rows rows (a leaf's few rows say little; its ancestors pool more alike
 - otherwise start crossing on a share >= warn_support: the lateral motion toward the
   centre line is at least start_speed x horizon (warns earlier).
 
+Holding back is bounded in time (release_s): it applies only while the person, at the
+constant velocity the baseline extrapolates, needs more than release_s to reach the
+robot's swept band (path_distance over the lateral speed toward the centre line). A
+walker who does keep going is then warned about no later than release_s before reaching
+the band, whatever their speed: a hold-back can delay a warning, never drop it below the
+lead a robot needs. (Session 7's unbounded hold-back cost 0.25 s of lead on validation
+and more on the faster judged walkers; docs/intent/ground-tree.md.)
+
 The shares, not the majority: a stop is rare among all rows even where it is likely,
 and the warning needs to know that it is likely, not that it is the commonest outcome.
 The case and the correction come from the leaf.
@@ -118,6 +126,8 @@ class IntentRules:
     warn_support: float = 1.01
     min_rows: int = 20
     start_speed: float = 1.0  # m/s toward the path's centre line when starting to cross
+    # s: hold back only while reaching the swept band takes longer than this (inf: always)
+    release_s: float = math.inf
 
     def __post_init__(self) -> None:
         for name in ("hold_back_support", "warn_support"):
@@ -128,6 +138,8 @@ class IntentRules:
             raise ValueError(f"min_rows must be >= 1, got {self.min_rows}")
         if not (math.isfinite(self.start_speed) and self.start_speed >= 0):
             raise ValueError(f"start_speed must be a finite number >= 0, got {self.start_speed}")
+        if not self.release_s > 0:  # NaN fails too
+            raise ValueError(f"release_s must be > 0 (inf: no bound), got {self.release_s}")
 
     def to_json(self) -> dict[str, Any]:
         return {
@@ -135,11 +147,13 @@ class IntentRules:
             "warn_support": self.warn_support,
             "min_rows": self.min_rows,
             "start_speed_mps": self.start_speed,
+            # JSON has no infinity: null is "no bound" (files before release_s lack the key)
+            "release_s": self.release_s if math.isfinite(self.release_s) else None,
         }
 
     @classmethod
     def from_json(cls, data: Mapping[str, Any]) -> IntentRules:
-        known = {"hold_back_support", "warn_support", "min_rows", "start_speed_mps"}
+        known = {"hold_back_support", "warn_support", "min_rows", "start_speed_mps", "release_s"}
         extra = set(data) - known
         if extra:
             raise ValueError(f"intent_rules has unknown keys {sorted(extra)}")
@@ -148,6 +162,7 @@ class IntentRules:
             warn_support=float(data["warn_support"]),
             min_rows=int(data["min_rows"]),
             start_speed=float(data["start_speed_mps"]),
+            release_s=math.inf if data.get("release_s") is None else float(data["release_s"]),
         )
 
 
@@ -338,8 +353,14 @@ def place(
     rules: IntentRules,
     horizon: float,
     model_horizon: float,
+    path_distance: float = math.nan,
 ) -> tuple[tuple[float, float], Action, Ops]:
-    """The predicted ground point from a leaf, and the operations spent (counted as run)."""
+    """The predicted ground point from a leaf, and the operations spent (counted as run).
+
+    `path_distance` (m to the swept band's nearer edge, GroundFeatures.path_distance)
+    bounds the hold-back in time (IntentRules.release_s); unknown (NaN), it allows no
+    hold-back under a finite release_s.
+    """
     c = ComparisonCounter()
     arithmetic = 0
     x, y = position
@@ -357,13 +378,20 @@ def place(
         elif c.lt(y, 0.0):
             toward = 1.0
         if not c.lt(reading.hold_share, rules.hold_back_support):
-            c.comparisons += 1  # which of the two
-            if reading.hold_intent == "stop":
-                px, py, action = x, y, Action.HOLD_STOP
-            else:
-                arithmetic += 2  # (py - y) * toward
-                if toward == 0.0 or c.lt(0.0, (py - y) * toward):
-                    py, action = y, Action.HOLD_TURN
+            in_time = True  # reaching the band takes longer than release_s (or no bound)
+            if math.isfinite(rules.release_s):  # a property of the model, not of the row
+                arithmetic += 2  # release_s x (toward x lateral speed)
+                in_time = c.finite(path_distance) and c.lt(
+                    rules.release_s * (toward * vl), path_distance
+                )
+            if in_time:  # else too near the band to hold back: constant velocity's point
+                c.comparisons += 1  # which of the two
+                if reading.hold_intent == "stop":
+                    px, py, action = x, y, Action.HOLD_STOP
+                else:
+                    arithmetic += 2  # (py - y) * toward
+                    if toward == 0.0 or c.lt(0.0, (py - y) * toward):
+                        py, action = y, Action.HOLD_TURN
         elif not c.lt(reading.start_share, rules.warn_support):
             c.comparisons += 1  # toward != 0: on the centre line there is no "toward"
             if toward != 0.0:
@@ -408,7 +436,13 @@ class IntentTreePredictor:
             reading = LeafReading.on_path(path, self.model.rules.min_rows)
             self._readings[id(node)] = reading
         point, action, placement = place(
-            g.position, g.velocity, reading, self.model.rules, horizon, self.model.horizon
+            g.position,
+            g.velocity,
+            reading,
+            self.model.rules,
+            horizon,
+            self.model.horizon,
+            g.path_distance,
         )
         return IntentDecision(reading, point, action, disc_ops, Ops(comparisons=tests), placement)
 
@@ -426,4 +460,9 @@ def worst_case_ops(model: IntentTreeModel) -> Ops:
     )
     rules = IntentRules(warn_support=1.0, min_rows=model.rules.min_rows, start_speed=1.0)
     _, _, placement = place((1.0, -1.0), (0.0, 0.0), reading, rules, 1.0, 1.0)
+    if model.rules.hold_back_support <= 1 and math.isfinite(model.rules.release_s):
+        held = replace(rules, hold_back_support=0.5, release_s=model.rules.release_s)
+        hold = replace(reading, hold_share=1.0, hold_intent="turn away")
+        _, _, placement_held = place((1.0, -1.0), (0.0, 1.0), hold, held, 1.0, 1.0, 2.0)
+        placement = max(placement, placement_held, key=lambda o: o.total)
     return model.discretiser.worst_case_ops() + Ops(comparisons=model.tree.depth) + placement

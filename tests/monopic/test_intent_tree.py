@@ -6,6 +6,7 @@ from __future__ import annotations
 import csv
 import json
 import math
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -56,6 +57,9 @@ CAM = CameraModel.from_fov(768, 432, 70, 1.0, pitch_deg=5)
 SPEED = 1.3  # m/s, walking toward the robot's path from its right (+ left)
 ROBOT_SPEED = 2.0
 HORIZON = 1.0
+# The hand-made stops come 0.5-0.7 s before the band at a 1 s horizon: a release time
+# below that lets the trainer hold back on them (the shipped grid starts at 1.1 s).
+TEST_RELEASE = (0.3,)
 
 
 # --- hand-made dataset: stop exactly when slowing near the kerb ---------------------------
@@ -173,7 +177,7 @@ def test_the_trainer_learns_slowing_near_the_kerb_means_stop(dataset: Path) -> N
     runs = read_dataset(dataset)
     assert len(runs) == 8 and all(len(r.rows) == 40 for r in runs)
     split = split_runs(runs)
-    result = train_intent_tree(runs, split)
+    result = train_intent_tree(runs, split, release_times=TEST_RELEASE)
     model = result.model
     assert model.tree.root.attribute in ("acceleration", "path_distance", "path_offset")
     predictor = IntentTreePredictor(model)
@@ -242,6 +246,41 @@ def test_the_predictor_holds_back_on_a_stop_leaf_and_the_warning_follows() -> No
     assert not warning.assess(f, held, Mode.GROUND, (768, 432), ego).collision
 
 
+def test_a_hold_back_is_released_when_the_band_is_nearer_than_the_release_time() -> None:
+    """0.7 m from the band at 1.3 m/s toward it: 0.54 s left. A 0.5 s release still holds
+    back, a 0.6 s one does not (the warning then fires as constant velocity's would)."""
+    f = ground_features(WALK_IN, (2.0, -1.0))
+    walk_in = (2.0, -1.0 + SPEED)
+    for release, held in ((0.5, True), (0.6, False), (math.inf, True)):
+        rules = IntentRules(hold_back_support=0.8, min_rows=20, release_s=release)
+        d = IntentTreePredictor(leaf_model("6/stop", 30, rules)).decide(f, 1.0)
+        assert (d.action is Action.HOLD_STOP) is held, release
+        assert d.point == pytest.approx((2.0, -1.0) if held else walk_in)
+    # Walking away from the band, or standing, leaves all the time in the world.
+    away = ground_features(dict(WALK_IN, left=-SPEED), (2.0, -1.0))
+    rules = IntentRules(hold_back_support=0.8, min_rows=20, release_s=5.0)
+    assert IntentTreePredictor(leaf_model("6/stop", 30, rules)).decide(away, 1.0).action is (
+        Action.HOLD_STOP
+    )
+    # Inside the band (distance 0) or unknown distance: never held back under a bound.
+    for dist in (0.0, math.nan):
+        g = ground_features(dict(WALK_IN, path_distance=dist), (2.0, -1.0))
+        d = IntentTreePredictor(leaf_model("6/stop", 30, rules)).decide(g, 1.0)
+        assert d.action is Action.NONE
+    # A turn-away leaf is released the same way.
+    turn = IntentTreePredictor(leaf_model("8/turn away", 30, replace(rules, release_s=0.6)))
+    assert turn.decide(f, 1.0).action is Action.NONE
+    assert turn.decide(f, 1.0).ops.total <= worst_case_ops(turn.model).total
+    with pytest.raises(ValueError, match="release_s must be > 0"):
+        IntentRules(release_s=0.0)
+    with pytest.raises(ValueError, match="release_s must be > 0"):
+        IntentRules(release_s=math.nan)
+    assert IntentRules.from_json(IntentRules(release_s=1.3).to_json()).release_s == 1.3
+    assert IntentRules.from_json(IntentRules().to_json()).release_s == math.inf
+    old = {k: v for k, v in IntentRules().to_json().items() if k != "release_s"}
+    assert IntentRules.from_json(old).release_s == math.inf  # files before release_s
+
+
 def test_the_rules_read_shares_at_the_deepest_node_with_enough_rows() -> None:
     # A leaf of 8 rows, all "keep going", under a node of 100 where a third stop or turn.
     leaf = Node(label="6/keep going", counts=(("6/keep going", 8),), mean=(0.0, 0.0))
@@ -304,7 +343,7 @@ def test_operation_counts_are_counted_as_run_and_bounded_by_the_worst_case() -> 
 
 def test_a_tree_file_round_trips_and_old_files_still_load(dataset: Path, tmp_path: Path) -> None:
     runs = read_dataset(dataset)
-    model = train_intent_tree(runs, split_runs(runs)).model
+    model = train_intent_tree(runs, split_runs(runs), release_times=TEST_RELEASE).model
     path = tmp_path / "ground.json"
     save_model(model, path)
     again = load_intent_model(path)
@@ -457,7 +496,7 @@ def test_sensitivity_replays_every_predictor_per_cue_value(
               "pedestrian.behaviour.head_check_probability": 0.0}, {lead: 0.4}]  # fmt: skip
     write_dataset(folder, {"kerb-c": 4}, seed=3, params={"kerb-c": drawn})
     runs = read_dataset(dataset)
-    model = train_intent_tree(runs, split_runs(runs)).model
+    model = train_intent_tree(runs, split_runs(runs), release_times=TEST_RELEASE).model
     judged = read_dataset(folder)
     s = sensitivity(judged, {"full": model}, [lead])
     assert s.predictors == ("constant velocity", "full") and s.runs == 4

@@ -410,17 +410,21 @@ def test_the_judged_intent_sweep_shares_no_run_or_seed_with_the_training_data() 
         (r.family, r.scenario.seed) for r in halves[1]
     }
     train = halves[0] + halves[1]
-    judged_path = SCENARIOS / "sweeps" / "intent-judged.toml"
-    data = tomllib.loads(judged_path.read_text())
-    assert data.pop("intent_tree") == "../../recordings/intent/ground.json"
-    judged = expand_spec(parse_spec(judged_path, data))  # the tree file is made later
-    assert {r.family for r in judged} == {r.family for r in train}
-    assert not {(r.family, r.scenario.seed) for r in train} & {
-        (r.family, r.scenario.seed) for r in judged
-    }
-    for key in ("scene.road.lane_width", "pedestrian.speed", "pedestrian.behaviour.stop_lead"):
-        top = max(r.params[key] for r in train)
-        assert min(r.params[key] for r in judged) > top, key
+    draws = []
+    for name in ("intent-judged.toml", "intent-judged-b.toml"):  # session 7's, session 8's
+        judged_path = SCENARIOS / "sweeps" / name
+        data = tomllib.loads(judged_path.read_text())
+        assert data.pop("intent_tree") == "../../recordings/intent/ground.json"
+        judged = expand_spec(parse_spec(judged_path, data))  # the tree file is made later
+        assert {r.family for r in judged} == {r.family for r in train}
+        assert not {(r.family, r.scenario.seed) for r in train} & {
+            (r.family, r.scenario.seed) for r in judged
+        }
+        for key in ("scene.road.lane_width", "pedestrian.speed", "pedestrian.behaviour.stop_lead"):
+            top = max(r.params[key] for r in train)
+            assert min(r.params[key] for r in judged) > top, key
+        draws.append({(r.family, r.scenario.seed) for r in judged})
+    assert not draws[0] & draws[1]  # the fresh draw repeats no run judged before
     # The cue-sensitivity dataset is judged too: other seeds, the judged road and speeds.
     sensitivity = expand_spec(load_spec(SCENARIOS / "datasets" / "intent-sensitivity.toml"))
     assert len(sensitivity) == 7 * 32
