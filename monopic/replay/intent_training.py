@@ -530,20 +530,22 @@ class RuleOption:
 
 def choose_rules(options: Sequence[RuleOption], cv: RunCount) -> RuleOption:
     """Fewest near-miss runs warned among the options that warn as many collision runs a
-    second ahead as constant velocity in every family; then fewest false and missed
-    frames. If none does, the most collision runs warned a second ahead. Ties: the
-    longer release time, the stricter supports, the lower start speed, corrections as
-    chosen before corrections off (the option listed first)."""
+    second ahead as constant velocity in every family; then the longest release time
+    (lead in hand), then fewest false and missed frames. If none does, the most collision
+    runs warned a second ahead. Ties: the stricter supports, the lower start speed,
+    corrections as chosen before corrections off (the option listed first)."""
     feasible = [o for o in options if o.runs.keeps_recall_of(cv)]
 
     def order(item: tuple[int, RuleOption]) -> tuple[float, ...]:
         k, o = item
         nm, fa, miss = o.runs.near_miss_warned, o.frames.false_alarms, o.frames.misses
-        first = (nm, fa, miss) if feasible else (-o.runs.warned_1s, nm, fa, miss)
+        # Equal on the goal's run counts, the longer release keeps more lead in hand for
+        # walkers unlike validation's; only then fewer false and missed frames.
+        keep = -o.rules.release_s
+        first = (nm, keep, fa, miss) if feasible else (-o.runs.warned_1s, nm, keep, fa, miss)
         rule = o.rules
         return (
             *first,
-            -rule.release_s,  # the longer lead kept
             -rule.hold_back_support,
             -rule.warn_support,
             rule.start_speed,
