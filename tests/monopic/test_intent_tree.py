@@ -483,6 +483,11 @@ def test_rules_are_chosen_for_fewest_near_misses_at_the_recall_of_constant_veloc
     # When no option keeps constant velocity's recall, the one warning most runs in time.
     worse = [option(0.5, 1, 1, 0), option(0.7, 2, 1, 2)]
     assert choose_rules(worse, cv).rules.hold_back_support == 0.7
+    # Equal on runs, the longer release time wins over fewer false frames.
+    short, long = option(0.6, 2, 2, 1, 2), option(0.6, 2, 2, 1, 9)
+    short = replace(short, rules=replace(short.rules, release_s=1.1))
+    long = replace(long, rules=replace(long.rules, release_s=1.4))
+    assert choose_rules([short, long], cv).rules.release_s == 1.4
 
 
 def test_sensitivity_replays_every_predictor_per_cue_value(
