@@ -468,6 +468,7 @@ class RunCount:
     near_miss_warned: int
     # (family, collision runs warned 1 s ahead) for every family with collision runs
     warned_1s_by_family: tuple[tuple[str, int], ...] = ()
+    mean_lead: float = math.nan  # s, first warning on course to contact, warned runs
 
     def keeps_recall_of(self, other: RunCount) -> bool:
         """Warns at least as many collision runs 1 s ahead as `other` in every family
@@ -492,6 +493,7 @@ def count_runs(warned: Sequence[bool], runs: Sequence[RunRows]) -> RunCount:
         raise ValueError(f"{len(warned)} flags for {rows} rows")
     collision_runs = warned_1s = near_miss_runs = near_miss_warned = 0
     by_family: dict[str, int] = {}
+    leads: list[float] = []
     k = 0
     for run in runs:
         flags = warned[k : k + len(run.rows)]
@@ -502,6 +504,8 @@ def count_runs(warned: Sequence[bool], runs: Sequence[RunRows]) -> RunCount:
             onset = next((row.time for w, row in pairs if w and row.on_course), None)
             contact = run.contact_time
             early = onset is not None and contact is not None
+            if early:
+                leads.append(contact - onset)
             early = early and contact - onset >= LEAD_GOAL_S - 1e-9
             warned_1s += early
             by_family[run.family] = by_family.get(run.family, 0) + early
@@ -514,6 +518,7 @@ def count_runs(warned: Sequence[bool], runs: Sequence[RunRows]) -> RunCount:
         near_miss_runs,
         near_miss_warned,
         tuple(sorted(by_family.items())),
+        float(np.mean(leads)) if leads else math.nan,
     )
 
 
@@ -721,6 +726,14 @@ def train_intent_tree(
         f"deepest node with at least {rules.min_rows} rows; hold back only while reaching "
         f"the swept band takes over {rules.release_s:g} s"
     )
+    table.append("The chosen rules with the release time varied (validation runs):")
+    for release in (*release_times, math.inf):
+        varied = replace(rules, release_s=release)
+        points = [predicted_point(best, s, horizon, varied) for s in val]
+        runs_at = count_runs(warned(points), split.validation)
+        said = f"{release:g} s" if math.isfinite(release) else "no bound"
+        table.append(f"  release {said}: {runs_at.describe()}, mean lead {runs_at.mean_lead:.2f} s")
+    table.append(f"  constant velocity: {cv_runs.describe()}, mean lead {cv_runs.mean_lead:.2f} s")
     table.append(f"Chosen: {best_cand.describe()} ({best_err:.3f} m)")
     table.append(f"  with the rules: {chosen.runs.describe()}; {count.describe()}")
     table.append(f"  constant velocity: {cv_runs.describe()}; {cv_count.describe()}")

@@ -454,6 +454,7 @@ def test_run_counts_follow_the_sweep_metrics_definitions() -> None:
     assert count_runs([False] * 4 + [True] * 3 + [False] * 4, runs).warned_1s == 0
     on_time = count_runs([False, False, True, False, False, False, False] + [False] * 4, runs)
     assert on_time.warned_1s_by_family == (("f", 1),)
+    assert on_time.mean_lead == pytest.approx(1.25)  # the lead of every warned run
     # Any warning on a near miss counts it as warned.
     assert count_runs([False] * 7 + [False, False, True, False], runs).near_miss_warned == 1
     with pytest.raises(ValueError, match="flags for 11 rows"):
