@@ -723,8 +723,8 @@ def train_intent_tree(
         "velocity's recall@1s in every family): hold back at a stop + turn-away share of "
         f"{_support(rules.hold_back_support)}, warn earlier at a start-crossing share of "
         f"{_support(rules.warn_support)} (start speed {rules.start_speed:g} m/s), read at the "
-        f"deepest node with at least {rules.min_rows} rows; hold back only while reaching "
-        f"the swept band takes over {rules.release_s:g} s"
+        f"deepest node with at least {rules.min_rows} rows; hold back only while getting "
+        f"within the warning's reach of the swept band takes over {rules.release_s:g} s"
     )
     table.append("The chosen rules with the release time varied (validation runs):")
     for release in (*release_times, math.inf):

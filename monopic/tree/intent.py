@@ -23,12 +23,14 @@ least min_rows rows (a leaf's few rows say little; its ancestors pool more alike
   centre line is at least start_speed x horizon (warns earlier).
 
 Holding back is bounded in time (release_s): it applies only while the person, at the
-constant velocity the baseline extrapolates, needs more than release_s to reach the
-robot's swept band (path_distance over the lateral speed toward the centre line). A
-walker who does keep going is then warned about no later than release_s before reaching
-the band, whatever their speed: a hold-back can delay a warning, never drop it below the
-lead a robot needs. (Session 7's unbounded hold-back cost 0.25 s of lead on validation
-and more on the faster judged walkers; docs/intent/ground-tree.md.)
+constant velocity the baseline extrapolates, needs more than release_s to come within the
+warning's reach of the robot's swept band (path_distance less the warning zone's margin
+and the pedestrian disc's radius, ZONE_REACH, over the lateral speed toward the centre
+line): where constant velocity's warning could fire. A walker who does keep going is then
+warned no later than about release_s before that, whatever their speed: a hold-back can
+delay a warning, never drop it below the lead a robot needs. (Session 7's unbounded
+hold-back cost 0.25 s of lead on validation and more on the faster judged walkers;
+docs/intent/ground-tree.md.)
 
 The shares, not the majority: a stop is rare among all rows even where it is likely,
 and the warning needs to know that it is likely, not that it is the commonest outcome.
@@ -60,6 +62,10 @@ from monopic.tree.ops import ComparisonCounter, Ops
 INTENTS = ("keep going", "stop", "turn away", "start crossing")
 HOLD_BACK_INTENTS = ("stop", "turn away")
 START_CROSSING = "start crossing"
+# m beyond the swept band where the ground warning can fire: the zone's safety margin
+# (RobotGeometry.margin, 0.2) and the pedestrian disc's radius (PEDESTRIAN_RADIUS, 0.3) of
+# monopic.variants.zone, which the tree may not import; a test holds them equal.
+ZONE_REACH = 0.5
 
 # The feature record's fields the tree may read, by attribute name (the order breaks
 # information-gain ties: velocity first, as the image tree).
@@ -380,9 +386,9 @@ def place(
         if not c.lt(reading.hold_share, rules.hold_back_support):
             in_time = True  # reaching the band takes longer than release_s (or no bound)
             if math.isfinite(rules.release_s):  # a property of the model, not of the row
-                arithmetic += 2  # release_s x (toward x lateral speed)
+                arithmetic += 3  # release_s x (toward x lateral speed); distance - reach
                 in_time = c.finite(path_distance) and c.lt(
-                    rules.release_s * (toward * vl), path_distance
+                    rules.release_s * (toward * vl), path_distance - ZONE_REACH
                 )
             if in_time:  # else too near the band to hold back: constant velocity's point
                 c.comparisons += 1  # which of the two

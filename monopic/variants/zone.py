@@ -14,6 +14,8 @@ import numpy as np
 
 from monopic.camera import CameraModel
 
+PEDESTRIAN_RADIUS = 0.3  # m: the disc a pedestrian is taken to be when meeting the robot
+
 
 @dataclass(frozen=True)
 class RobotGeometry:
@@ -109,7 +111,7 @@ def meets_swept_footprint(
     speed: float,
     yaw_rate: float,
     horizon: float,
-    radius: float = 0.3,
+    radius: float = PEDESTRIAN_RADIUS,
     steps: int = 20,
 ) -> float | None:
     """First time (s) a pedestrian moving linearly start->end over the horizon meets the robot.

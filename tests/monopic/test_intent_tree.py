@@ -57,9 +57,10 @@ CAM = CameraModel.from_fov(768, 432, 70, 1.0, pitch_deg=5)
 SPEED = 1.3  # m/s, walking toward the robot's path from its right (+ left)
 ROBOT_SPEED = 2.0
 HORIZON = 1.0
-# The hand-made stops come 0.5-0.7 s before the band at a 1 s horizon: a release time
-# below that lets the trainer hold back on them (the shipped grid starts at 1.1 s).
-TEST_RELEASE = (0.3,)
+# The hand-made stops come 0.1-0.4 m (0.08-0.3 s) short of where the warning can fire (the
+# band's edge less ZONE_REACH): a release time below that lets the trainer hold back on
+# them (the shipped grid starts at 1.1 s).
+TEST_RELEASE = (0.05,)
 
 
 # --- hand-made dataset: stop exactly when slowing near the kerb ---------------------------
@@ -247,15 +248,20 @@ def test_the_predictor_holds_back_on_a_stop_leaf_and_the_warning_follows() -> No
 
 
 def test_a_hold_back_is_released_when_the_band_is_nearer_than_the_release_time() -> None:
-    """0.7 m from the band at 1.3 m/s toward it: 0.54 s left. A 0.5 s release still holds
-    back, a 0.6 s one does not (the warning then fires as constant velocity's would)."""
-    f = ground_features(WALK_IN, (2.0, -1.0))
-    walk_in = (2.0, -1.0 + SPEED)
+    """1.2 m from the band, 0.7 m beyond the warning's reach (ZONE_REACH), at 1.3 m/s
+    toward it: 0.54 s left. A 0.5 s release still holds back, a 0.6 s one does not (the
+    warning then fires as constant velocity's would)."""
+    from monopic.tree.intent import ZONE_REACH
+    from monopic.variants.zone import PEDESTRIAN_RADIUS
+
+    assert math.isclose(ZONE_REACH, RobotGeometry().margin + PEDESTRIAN_RADIUS)
+    f = ground_features(dict(WALK_IN, path_distance=1.2), (2.0, -1.5))
+    walk_in = (2.0, -1.5 + SPEED)
     for release, held in ((0.5, True), (0.6, False), (math.inf, True)):
         rules = IntentRules(hold_back_support=0.8, min_rows=20, release_s=release)
         d = IntentTreePredictor(leaf_model("6/stop", 30, rules)).decide(f, 1.0)
         assert (d.action is Action.HOLD_STOP) is held, release
-        assert d.point == pytest.approx((2.0, -1.0) if held else walk_in)
+        assert d.point == pytest.approx((2.0, -1.5) if held else walk_in)
     # Walking away from the band, or standing, leaves all the time in the world.
     away = ground_features(dict(WALK_IN, left=-SPEED), (2.0, -1.0))
     rules = IntentRules(hold_back_support=0.8, min_rows=20, release_s=5.0)

@@ -411,7 +411,7 @@ def test_the_judged_intent_sweep_shares_no_run_or_seed_with_the_training_data() 
     }
     train = halves[0] + halves[1]
     draws = []
-    for name in ("intent-judged.toml", "intent-judged-b.toml"):  # session 7's, session 8's
+    for name in ("intent-judged.toml", "intent-judged-b.toml", "intent-judged-c.toml"):
         judged_path = SCENARIOS / "sweeps" / name
         data = tomllib.loads(judged_path.read_text())
         assert data.pop("intent_tree") == "../../recordings/intent/ground.json"
@@ -424,7 +424,8 @@ def test_the_judged_intent_sweep_shares_no_run_or_seed_with_the_training_data() 
             top = max(r.params[key] for r in train)
             assert min(r.params[key] for r in judged) > top, key
         draws.append({(r.family, r.scenario.seed) for r in judged})
-    assert not draws[0] & draws[1]  # the fresh draw repeats no run judged before
+    for k, draw in enumerate(draws):  # each fresh draw repeats no run judged before
+        assert not draw & set().union(*draws[:k])
     # The cue-sensitivity dataset is judged too: other seeds, the judged road and speeds.
     sensitivity = expand_spec(load_spec(SCENARIOS / "datasets" / "intent-sensitivity.toml"))
     assert len(sensitivity) == 7 * 32
