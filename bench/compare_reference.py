@@ -373,6 +373,11 @@ def main() -> None:
     )
     ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
+    from monopic.pose.sessions import runtime_unavailable
+
+    why_not = runtime_unavailable(args.runtime)  # e.g. openvino on an AMD CPU
+    if why_not is not None:
+        sys.exit(f"compare_reference: --runtime {args.runtime}: {why_not}")
     recorder = Recorder("compare_reference", TITLE)
     npy, npz = build()
     fs = load(npy, npz)
