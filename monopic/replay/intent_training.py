@@ -69,9 +69,9 @@ HOLD_SHARES = (0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8, 1.01)
 WARN_SHARES = (0.3, 0.5, 0.7, 0.9, 1.01)
 START_SPEEDS = (0.6, 1.0, 1.4)
 RULE_ROWS = (20, 50, 100, 200, 400)  # min_rows: how many rows the rule node must hold
-# s: a hold-back applies only while reaching the swept band takes longer than this
-# (IntentRules.release_s). Always finite: an unbounded hold-back cost the judged walkers
-# their lead in session 7. From just above the 1 s of recall@1s up.
+# s: a hold-back applies only while getting within the warning's reach of the swept band
+# takes longer than this (IntentRules.release_s). Always finite: an unbounded hold-back
+# cost the judged walkers their lead in session 7. From just above the 1 s of recall@1s up.
 RELEASE_TIMES = (1.1, 1.2, 1.3, 1.4, 1.6, 2.0)
 DEFAULT_MIN_SAMPLES = 20
 
@@ -549,13 +549,7 @@ def choose_rules(options: Sequence[RuleOption], cv: RunCount) -> RuleOption:
         keep = -o.rules.release_s
         first = (nm, keep, fa, miss) if feasible else (-o.runs.warned_1s, nm, keep, fa, miss)
         rule = o.rules
-        return (
-            *first,
-            -rule.hold_back_support,
-            -rule.warn_support,
-            rule.start_speed,
-            k,
-        )
+        return (*first, -rule.hold_back_support, -rule.warn_support, rule.start_speed, k)
 
     return min(enumerate(feasible or options), key=order)[1]
 

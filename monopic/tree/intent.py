@@ -384,13 +384,13 @@ def place(
         elif c.lt(y, 0.0):
             toward = 1.0
         if not c.lt(reading.hold_share, rules.hold_back_support):
-            in_time = True  # reaching the band takes longer than release_s (or no bound)
+            in_time = True  # the warning's reach is further than release_s (or no bound)
             if math.isfinite(rules.release_s):  # a property of the model, not of the row
                 arithmetic += 3  # release_s x (toward x lateral speed); distance - reach
                 in_time = c.finite(path_distance) and c.lt(
                     rules.release_s * (toward * vl), path_distance - ZONE_REACH
                 )
-            if in_time:  # else too near the band to hold back: constant velocity's point
+            if in_time:  # else too near to hold back: constant velocity's point stands
                 c.comparisons += 1  # which of the two
                 if reading.hold_intent == "stop":
                     px, py, action = x, y, Action.HOLD_STOP

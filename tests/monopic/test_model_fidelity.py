@@ -68,14 +68,11 @@ def session(model: str, runtime: str = "cpu") -> ort.InferenceSession:
 
 # Every runtime the pipeline offers must reproduce the TFLite models within the same
 # tolerances; the optional one is skipped, saying so, where its extra is not installed.
+UNAVAILABLE = {r: runtime_unavailable(r) for r in RUNTIMES}  # why not, asked once each
 RUNTIME_PARAMS = [
     pytest.param(
         r,
-        marks=[]
-        if r == "cpu"
-        else pytest.mark.skipif(
-            runtime_unavailable(r) is not None, reason=str(runtime_unavailable(r))
-        ),
+        marks=pytest.mark.skipif(UNAVAILABLE[r] is not None, reason=str(UNAVAILABLE[r])),
     )
     for r in RUNTIMES
 ]

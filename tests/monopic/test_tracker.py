@@ -266,9 +266,10 @@ def test_an_unknown_landmark_model_is_refused_with_the_choices():
         TrackerConfig(model="medium")
 
 
-@pytest.mark.skipif(
-    runtime_unavailable("openvino") is not None, reason=str(runtime_unavailable("openvino"))
-)
+OPENVINO_UNAVAILABLE = runtime_unavailable("openvino")  # why not, asked once
+
+
+@pytest.mark.skipif(OPENVINO_UNAVAILABLE is not None, reason=str(OPENVINO_UNAVAILABLE))
 def test_the_openvino_runtime_gives_the_cpu_runtimes_landmarks_on_the_clip():
     """The same crops, the same landmarks: OpenVINO computes in float32 (no bfloat16 on
     AMX). Measured: at most 2e-4 px apart. (Tracked over 40 frames the two drift up to
