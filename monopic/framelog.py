@@ -26,7 +26,7 @@ OUR_COLUMNS = (
     "landmarksMs", "featuresMs", "predictMs", "warningMs", "totalMs",
     # Intent features (docs/intent/features.md), empty where not known.
     "phiRate", "headYaw", "headVisibility", "groundSpeed", "groundAcceleration",
-    "groundHeadingRate", "pathOffset", "pathDistance",
+    "groundHeadingRate", "pathOffset", "pathDistance", "headFacing", "headToward",
 )  # fmt: skip
 FRAME_COLUMNS = AUTHORS_COLUMNS + OUR_COLUMNS
 
@@ -60,7 +60,8 @@ def frame_row(r: FrameResult, fps: float, horizon: float) -> list:
         _cell(f.phi_rate, 2), _cell(f.head_yaw, 2), _cell(f.head_visibility, 3),
         _cell(g.speed if g else nan, 3), _cell(g.acceleration if g else nan, 3),
         _cell(g.heading_rate if g else nan, 2), _cell(g.path_offset if g else nan, 3),
-        _cell(g.path_distance if g else nan, 3),
+        _cell(g.path_distance if g else nan, 3), _cell(f.head_facing, 2),
+        _cell(f.head_toward, 2),
     ]  # fmt: skip
 
 

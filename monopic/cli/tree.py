@@ -180,7 +180,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         choices=INTENT_ATTRIBUTES,
         metavar="ATTR",
         help="ground mode: grow the tree without this feature (repeatable; e.g. the body "
-        f"features phi, phi_rate, head_yaw for a motion-only tree; one of "
+        f"features phi, phi_rate, head_yaw, head_toward for a motion-only tree; one of "
         f"{', '.join(INTENT_ATTRIBUTES)})",
     )
     t.add_argument(

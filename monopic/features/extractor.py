@@ -8,7 +8,7 @@ import numpy as np
 
 from monopic.features.ground import GroundMotion
 from monopic.features.ground_track import GroundTrackConfig
-from monopic.features.head import MIN_HEAD_VISIBILITY, head_yaw
+from monopic.features.head import MIN_HEAD_VISIBILITY, HeadTurnWindow, head_facing, head_yaw
 from monopic.features.motion import VelocityEstimator
 from monopic.features.orientation import facing_angle
 from monopic.features.record import Features, GroundFeatures
@@ -58,6 +58,7 @@ class FeatureExtractor:
     _image_velocity: VelocityEstimator = field(init=False)
     _ground: GroundMotion = field(init=False)
     _phi_history: SlidingWindow = field(init=False)
+    _head_turn: HeadTurnWindow = field(default_factory=HeadTurnWindow, init=False)
     _last_seen: float | None = field(default=None, init=False)
 
     def __post_init__(self) -> None:
@@ -87,6 +88,8 @@ class FeatureExtractor:
         self._phi_history.add(timestamp, phi)
         vx, vy = self._image_velocity.update(timestamp, *center)
         head = head_yaw(pose.landmarks, pose.visibility, self.min_head_visibility)
+        facing = head_facing(pose.landmarks, pose.visibility, self.min_head_visibility)
+        head_toward = self._head_turn.update(timestamp, facing)
         ground = None
         if ego is not None:
             g = self._ground.update(timestamp, ego, foot, pose.height)
@@ -116,6 +119,8 @@ class FeatureExtractor:
             phi_rate=angle_rate(self._phi_history),
             head_yaw=head.yaw,
             head_visibility=head.visibility,
+            head_facing=facing,
+            head_toward=head_toward,
         )
 
     def _reset_track(self) -> None:
@@ -123,3 +128,4 @@ class FeatureExtractor:
         self._ground.reset_track()
         self.phi_filter.reset()
         self._phi_history.reset()
+        self._head_turn.reset()

@@ -23,7 +23,8 @@ head line when both are visible, which averages down their noise.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections import deque
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -31,6 +32,10 @@ from monopic.pose.skeleton import INDEX, LEFT_SHOULDER, RIGHT_SHOULDER
 
 LEFT_EYE, RIGHT_EYE = INDEX["left_eye"], INDEX["right_eye"]
 LEFT_EAR, RIGHT_EAR = INDEX["left_ear"], INDEX["right_ear"]
+NOSE = INDEX["nose"]
+# The head's proportions the image facing divides by (the ratio is what counts):
+NOSE_AHEAD_M = 0.10  # ear axis to the nose tip, adult head (assumed)
+EYE_SEPARATION_M = 0.063  # the adult mean interpupillary distance (Dodgson 2004)
 # Below this BlazePose visibility a landmark is not trusted for the head yaw.
 MIN_HEAD_VISIBILITY = 0.5
 
@@ -72,3 +77,59 @@ def head_yaw(
     head = math.atan2(sum(math.sin(a) for a in heads), sum(math.cos(a) for a in heads))
     d = math.degrees(head - shoulders)
     return HeadYaw(-((-d + 180.0) % 360.0 - 180.0), vis)
+
+
+def head_facing(
+    landmarks: np.ndarray, visibility: np.ndarray, min_visibility: float = MIN_HEAD_VISIBILITY
+) -> float:
+    """The head's facing from the camera (deg, 0 at it, + to the person's left), image x only.
+
+    Why not depth: BlazePose's depths of points across the head follow a head turn by about
+    a fifth at every distance (tools/head_reading.py), while the image keeps it. Seen from
+    the camera, the nose sits ahead of the ears' midpoint by NOSE_AHEAD_M sin(facing) and
+    the eyes lie EYE_SEPARATION_M cos(facing) apart, left minus right (the person's left
+    eye is on the image right when the face is toward the camera). NaN when the nose, an
+    eye or an ear is below `min_visibility` (a head seen from behind).
+    """
+    idx = (NOSE, LEFT_EYE, RIGHT_EYE, LEFT_EAR, RIGHT_EAR)
+    if not min(float(visibility[i]) for i in idx) >= min_visibility:
+        return float("nan")
+    ears_mid = (float(landmarks[LEFT_EAR, 0]) + float(landmarks[RIGHT_EAR, 0])) / 2
+    ahead = (float(landmarks[NOSE, 0]) - ears_mid) / NOSE_AHEAD_M
+    across = (float(landmarks[LEFT_EYE, 0]) - float(landmarks[RIGHT_EYE, 0])) / EYE_SEPARATION_M
+    if math.hypot(ahead, across) < 1e-9:
+        return float("nan")
+    return math.degrees(math.atan2(ahead, across))
+
+
+@dataclass
+class HeadTurnWindow:
+    """How far the head has turned toward the camera lately (deg, + toward it).
+
+    A head check is a change while the walk keeps its line, so it is read as one: the
+    median |facing| between `past_s` seconds ago less the median |facing| over the last
+    `now_s` seconds. Medians, because one frame's facing scatters by 20-30 degrees on a
+    walker. NaN until both windows hold enough samples; restart it with the track.
+    """
+
+    now_s: float = 0.15  # about 3 frames at 15 fps
+    past_s: tuple[float, float] = (0.5, 1.5)  # a check lasts about a second (scenarios/README)
+    min_now: int = 2
+    min_past: int = 4
+    _samples: deque[tuple[float, float]] = field(default_factory=deque, init=False)
+
+    def update(self, timestamp: float, facing: float) -> float:
+        """Add this frame's facing (NaN: not seen) and return the turn toward the camera."""
+        if math.isfinite(facing):
+            self._samples.append((timestamp, abs(facing)))
+        while self._samples and self._samples[0][0] < timestamp - self.past_s[1] - 1e-9:
+            self._samples.popleft()
+        now = [f for t, f in self._samples if t >= timestamp - self.now_s - 1e-9]
+        far, near = timestamp - self.past_s[1] - 1e-9, timestamp - self.past_s[0] + 1e-9
+        past = [f for t, f in self._samples if far <= t <= near]
+        if len(now) < self.min_now or len(past) < self.min_past:
+            return float("nan")
+        return float(np.median(past) - np.median(now))
+
+    def reset(self) -> None:
+        self._samples.clear()

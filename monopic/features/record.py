@@ -53,3 +53,5 @@ class Features:
     phi_rate: float = _NAN  # deg/s, least-squares slope of the smoothed phi over 0.5 s
     head_yaw: float = _NAN  # deg, head from the shoulders, + to the person's left (head.py)
     head_visibility: float = _NAN  # 0-1, min visibility of the ears and shoulders
+    head_facing: float = _NAN  # deg, the head's facing from the camera, image x only (head.py)
+    head_toward: float = _NAN  # deg, head turned toward the camera over the last ~1 s

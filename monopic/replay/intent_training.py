@@ -55,6 +55,7 @@ FEATURE_COLUMNS = {
     "phi": "angleOfApproach",
     "phi_rate": "phiRate",
     "head_yaw": "headYaw",
+    "head_toward": "headToward",
     "path_offset": "pathOffset",
     "path_distance": "pathDistance",
 }

@@ -78,6 +78,7 @@ INTENT_ATTRIBUTES = (
     "phi",
     "phi_rate",
     "head_yaw",
+    "head_toward",
     "path_offset",
     "path_distance",
 )
@@ -116,6 +117,7 @@ def intent_values(features: Features) -> dict[str, float]:
         "phi": features.phi,
         "phi_rate": features.phi_rate,
         "head_yaw": features.head_yaw,
+        "head_toward": features.head_toward,
         "path_offset": g.path_offset,
         "path_distance": g.path_distance,
     }

@@ -10,7 +10,15 @@ import pytest
 from monopic.camera import CameraModel
 from monopic.features.extractor import DEFAULT_ROBOT_WIDTH, FeatureExtractor
 from monopic.features.ground import GroundMotion, Odometry
-from monopic.features.head import LEFT_EAR, LEFT_EYE, RIGHT_EAR, RIGHT_EYE, head_yaw
+from monopic.features.head import (
+    LEFT_EAR,
+    LEFT_EYE,
+    RIGHT_EAR,
+    RIGHT_EYE,
+    HeadTurnWindow,
+    head_facing,
+    head_yaw,
+)
 from monopic.features.swept_path import path_offset
 from monopic.features.window import (
     GroundKinematics,
@@ -277,6 +285,57 @@ def test_extractor_reports_head_yaw_and_its_visibility() -> None:
     f = FeatureExtractor().update(0.0, _pose(_body(-70.0, 35.0)), 432)
     assert f.head_yaw == pytest.approx(35.0, abs=1e-6)
     assert f.head_visibility == 1.0
+
+
+# -- head facing from the camera and the turn toward it ---------------------------------------
+
+
+@pytest.mark.parametrize("facing", [-90.0, -60.0, -120.0])
+@pytest.mark.parametrize("head", [0.0, 40.0, -30.0, 60.0])
+def test_head_facing_reads_the_head_from_the_camera_in_image_x_alone(
+    facing: float, head: float
+) -> None:
+    lm = _body(facing, head)
+    lm[:, 2] = 0.0  # no depth at all: the facing needs none
+    # _body's -90 faces the camera; its eyes are 60 mm apart where the reading assumes 63.
+    assert head_facing(lm, np.ones(33)) == pytest.approx(facing + head + 90.0, abs=2.0)
+
+
+def test_head_facing_is_nan_when_the_face_is_not_seen() -> None:
+    vis = np.ones(33)
+    vis[RIGHT_EYE] = 0.1
+    assert math.isnan(head_facing(_body(-90.0, 20.0), vis))
+
+
+def test_a_head_check_toward_the_camera_reads_as_a_turn_toward_it() -> None:
+    window = HeadTurnWindow()
+    t = np.arange(0.0, 3.0, 1 / 15)
+    # Walking across, the head 70 deg from the camera; from 2 s on it turns to 20 deg.
+    facing = np.where(t < 2.0, -70.0, -20.0)
+    out = [window.update(float(ti), float(f)) for ti, f in zip(t, facing, strict=True)]
+    assert math.isnan(out[0]) and math.isnan(out[9])  # not 4 samples 0.5 s back yet
+    steady = [o for ti, o in zip(t, out, strict=True) if 0.8 < ti < 2.0]
+    assert steady and all(o == pytest.approx(0.0) for o in steady)
+    after = [o for ti, o in zip(t, out, strict=True) if 2.15 < ti < 2.5]
+    assert after and all(o == pytest.approx(50.0) for o in after)
+    # Reset forgets all; a glance away reads negative; a frame with no face adds nothing.
+    window.reset()
+    assert math.isnan(window.update(3.1, -20.0))
+    away = HeadTurnWindow()
+    for k, ti in enumerate(np.arange(0.0, 1.6, 1 / 15)):
+        facing = math.nan if k == 4 else -10.0 if ti < 1.3 else -60.0
+        last = away.update(float(ti), facing)
+    assert last == pytest.approx(-50.0)
+
+
+def test_extractor_reports_head_facing_and_the_turn_and_restarts_with_the_track() -> None:
+    fx = FeatureExtractor()
+    for i in range(30):
+        head = 0.0 if i < 25 else 50.0  # facing the camera body-wise, head turns left
+        f = fx.update(i / 15, _pose(_body(-90.0, head)), 432)
+    assert f.head_facing == pytest.approx(50.0, abs=2.0)
+    assert f.head_toward == pytest.approx(-50.0, abs=2.0)  # turned away from the camera
+    assert math.isnan(fx.update(5.0, _pose(_body(-90.0, 0.0)), 432).head_toward)
 
 
 # -- the swept path ---------------------------------------------------------------------------

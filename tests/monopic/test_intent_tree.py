@@ -81,6 +81,7 @@ def _row(rng: np.random.Generator, slowing: bool, near: bool) -> dict:
         "phi": rng.uniform(-180, 180),
         "phi_rate": rng.normal(0, 30),
         "head_yaw": rng.normal(0, 10),
+        "head_toward": 0.0,  # never looks: the draws above stay the same
         "path_offset": y,
         "path_distance": gap,
     }
@@ -171,6 +172,7 @@ def ground_features(values: dict[str, float], position: tuple[float, float]) -> 
     return Features(
         1.0, (400.0, 300.0), (400.0, 380.0), 160.0, values["phi"], 0.0, 0.0, g,
         phi_rate=values["phi_rate"], head_yaw=values["head_yaw"],
+        head_toward=values["head_toward"],
     )  # fmt: skip
 
 
@@ -228,7 +230,8 @@ def leaf_model(label: str, n: int, rules: IntentRules, mean=(0.0, 0.0)) -> Inten
 
 WALK_IN = {
     "forward": 0.0, "left": SPEED, "speed": SPEED, "acceleration": -1.2, "heading_rate": 0.0,
-    "phi": 90.0, "phi_rate": 0.0, "head_yaw": 0.0, "path_offset": -1.0, "path_distance": 0.7,
+    "phi": 90.0, "phi_rate": 0.0, "head_yaw": 0.0, "head_toward": 0.0, "path_offset": -1.0,
+    "path_distance": 0.7,
 }  # fmt: skip
 
 
