@@ -1,0 +1,43 @@
+"""tools/intent_cue_auc.py: the AUC it prints, and a wrong folder as one line."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from tests.paths import ROOT
+
+TOOL = ROOT / "tools" / "intent_cue_auc.py"
+_spec = importlib.util.spec_from_file_location("intent_cue_auc", TOOL)
+assert _spec is not None and _spec.loader is not None
+intent_cue_auc = importlib.util.module_from_spec(_spec)
+_spec.loader.exec_module(intent_cue_auc)
+
+
+def test_auc_of_separated_reversed_tied_and_empty_groups() -> None:
+    assert intent_cue_auc.auc([3.0, 4.0], [1.0, 2.0]) == 1.0
+    assert intent_cue_auc.auc([1.0, 2.0], [3.0, 4.0]) == 0.0
+    assert intent_cue_auc.auc([1.0, 1.0], [1.0, 1.0, 1.0]) == 0.5
+    assert math.isnan(intent_cue_auc.auc([], [1.0]))
+
+
+def test_auc_is_the_share_of_pairs_ordered_right() -> None:
+    rng = np.random.default_rng(3)
+    pos, neg = rng.integers(0, 5, 30).astype(float), rng.integers(0, 5, 40).astype(float)
+    pairs = [(p > n) + 0.5 * (p == n) for p in pos for n in neg]
+    assert intent_cue_auc.auc(list(pos), list(neg)) == pytest.approx(np.mean(pairs))
+
+
+def test_a_folder_that_is_no_dataset_is_one_line(tmp_path: Path) -> None:
+    r = subprocess.run(
+        [sys.executable, str(TOOL), str(tmp_path)], capture_output=True, text=True, timeout=120
+    )
+    assert r.returncode == 2 and r.stdout == ""
+    (line,) = r.stderr.strip().splitlines()
+    assert line.startswith(f"intent_cue_auc: {tmp_path}: not a dataset folder")
