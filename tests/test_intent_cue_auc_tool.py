@@ -1,4 +1,4 @@
-"""tools/intent_cue_auc.py: the AUC it prints, and a wrong folder as one line."""
+"""tools/intent_cue_auc.py and intent_cue_gate.py: the AUC, and wrong input as one line."""
 
 from __future__ import annotations
 
@@ -41,3 +41,14 @@ def test_a_folder_that_is_no_dataset_is_one_line(tmp_path: Path) -> None:
     assert r.returncode == 2 and r.stdout == ""
     (line,) = r.stderr.strip().splitlines()
     assert line.startswith(f"intent_cue_auc: {tmp_path}: not a dataset folder")
+
+
+def test_the_cue_gate_tool_names_a_missing_tree_in_one_line(tmp_path: Path) -> None:
+    tool = ROOT / "tools" / "intent_cue_gate.py"
+    r = subprocess.run(
+        [sys.executable, str(tool), str(tmp_path / "none.json"), str(tmp_path)],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert r.returncode == 2 and r.stdout == ""
+    (line,) = r.stderr.strip().splitlines()
+    assert line.startswith(f"intent_cue_gate: {tmp_path / 'none.json'}")
