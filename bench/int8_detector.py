@@ -1,0 +1,221 @@
+"""An int8 detector against the float one: calibration windows, detection agreement, time.
+
+The search frames (four detector passes while nobody is tracked) are about a quarter of a
+scenario run's time (issue 17) and of our CPU-seconds against MediaPipe (issue 21). An int8
+detector would make each pass cheaper; it is worth shipping only if it finds the same
+people in the same places. Three steps:
+
+    .venv/bin/python bench/int8_detector.py windows --out recordings/int8/detector_windows.npz
+        the detector's letterboxed input windows (the whole frame and every tile of the
+        search cascade) of the calibration frame set (bench/frameset.py CALIBRATION),
+        uint8, at most 600 of them
+    .venv-models/bin/python tools/models/quantize.py --detector \
+        --crops recordings/int8/detector_windows.npz --out recordings/int8/pose_detection_int8.onnx
+    .venv/bin/python bench/int8_detector.py judge recordings/int8/pose_detection_int8.onnx
+        on the large frame set (bench/frameset.py LARGE; other seeds and distances): every
+        window through both detectors (who is found, and how far the int8 detection's
+        keypoints move, over the float box's height), the tracker with each detector
+        (share of frames found, sequences reset), and both timed on the same windows,
+        alternated, at 1 thread
+
+`judge` appends one line to bench/history.jsonl unless --no-append. Nothing is shipped by
+this script: the shipped detector stays the float one unless a judged run says otherwise.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+from frameset import CALIBRATION, LARGE, FrameSet, build, load  # noqa: E402
+from history import Recorder  # noqa: E402
+
+from monopic.pose.anchors import INPUT_SIZE  # noqa: E402
+from monopic.pose.detector import Detection, PoseDetector, letterbox  # noqa: E402
+from monopic.pose.search import Window, search_windows  # noqa: E402
+from monopic.pose.sessions import make_session  # noqa: E402
+from monopic.pose.tracker import PoseTracker, TrackerConfig  # noqa: E402
+
+TITLE = "An int8 detector against the float one (issue 17's search frames, issue 21's CPU)"
+FLOAT, INT8 = "float (shipped)", "int8 candidate"
+MAX_WINDOWS = 600
+
+
+def all_windows(width: int, height: int) -> list[Window]:
+    """The whole frame and every tile the tracker's cascade visits (no ground band)."""
+    cfg = TrackerConfig()
+    levels = search_windows(width, height, cfg.acquire_tiles, cfg.far_tiles, cfg.tile_overlap, None)
+    return [Window(0, 0, width, height), *[w for level in levels for w in level]]
+
+
+def detector_with(path: Path | None) -> PoseDetector:
+    """The shipped detector; with `path`, its session runs that file instead."""
+    detector = PoseDetector(1)
+    if path is not None:
+        session = make_session(path, 1)
+        if session.get_inputs()[0].name != detector.input_name:
+            raise SystemExit(f"int8_detector: {path} does not take the detector's input")
+        detector.session = session
+    return detector
+
+
+def cmd_windows(args: argparse.Namespace) -> None:
+    fs = load(*build(recipe=CALIBRATION))
+    h, w = fs.images.shape[1:3]
+    tensors = [
+        letterbox(np.asarray(fs.images[i]), win, INPUT_SIZE)[0]
+        for i in range(len(fs))
+        for win in all_windows(w, h)
+    ]
+    rng = np.random.default_rng(0)
+    pick = np.sort(rng.choice(len(tensors), min(MAX_WINDOWS, len(tensors)), replace=False))
+    windows = np.stack(
+        [np.clip(np.rint((tensors[i] + 1.0) * 127.5), 0, 255).astype(np.uint8) for i in pick]
+    )
+    args.out.parent.mkdir(parents=True, exist_ok=True)
+    tmp = args.out.with_suffix(".tmp.npz")
+    np.savez_compressed(tmp, crops=windows)
+    os.replace(tmp, args.out)
+    print(f"{args.out}: {len(windows)} of {len(tensors)} windows from {len(fs)} frames")
+
+
+def best(dets: list[Detection]) -> Detection | None:
+    return dets[0] if dets else None
+
+
+def track(fs: FrameSet, detector: PoseDetector) -> np.ndarray:
+    """Frames the shipped tracker found someone in, with `detector` as its detector."""
+    tracker = PoseTracker(TrackerConfig(threads=1))
+    tracker.detector = detector
+    found = []
+    for i in range(len(fs)):
+        if i == 0 or fs.sequence[i] != fs.sequence[i - 1]:
+            tracker.reset()
+        r = tracker.process(np.asarray(fs.images[i]), timestamp=float(fs.timestamp[i]))
+        found.append(r.found)
+    return np.array(found)
+
+
+def pass_times(paths: dict[str, Path | None], tensors: list[np.ndarray], rounds: int) -> dict:
+    """Median ms per detector pass of each model on the same windows, alternated."""
+    detectors = {k: detector_with(p) for k, p in paths.items()}
+    samples: dict[str, list[float]] = {k: [] for k in detectors}
+    loads = []
+    order = list(detectors)
+    for r in range(rounds):
+        loads.append(os.getloadavg()[0])
+        for k in order if r % 2 == 0 else order[::-1]:
+            d = detectors[k]
+            for t in tensors:
+                t0 = time.perf_counter()
+                d.session.run([d.regressor_name, d.score_name], {d.input_name: t[None]})
+                samples[k].append(1e3 * (time.perf_counter() - t0))
+    return {
+        "ms": {k: float(np.median(v)) for k, v in samples.items()},
+        "load_min": min(loads),
+        "load_max": max(loads),
+    }
+
+
+def cmd_judge(args: argparse.Namespace) -> None:
+    if not args.model.is_file():
+        raise SystemExit(f"int8_detector: {args.model}: no such file")
+    recorder = Recorder("int8_detector", TITLE)
+    fs = load(*build(recipe=LARGE))
+    h, w = fs.images.shape[1:3]
+    dets = {FLOAT: detector_with(None), INT8: detector_with(args.model)}
+    windows = all_windows(w, h)
+    found = {FLOAT: 0, INT8: 0}
+    both = only_float = only_int8 = 0
+    moved: list[float] = []
+    for i in range(len(fs)):
+        image = np.asarray(fs.images[i])
+        for win in windows:
+            f = best(dets[FLOAT].detect(image, [win]))
+            q = best(dets[INT8].detect(image, [win]))
+            found[FLOAT] += f is not None
+            found[INT8] += q is not None
+            if f is not None and q is not None:
+                both += 1
+                height = max(f.box[3] - f.box[1], 1.0)
+                moved.append(
+                    float(np.linalg.norm(f.keypoints - q.keypoints, axis=1).max()) / height
+                )
+            elif f is not None:
+                only_float += 1
+            elif q is not None:
+                only_int8 += 1
+    tracked = {k: track(fs, d) for k, d in dets.items()}
+    sample = [
+        letterbox(np.asarray(fs.images[i]), win, INPUT_SIZE)[0]
+        for i in range(0, len(fs), max(1, len(fs) // 12))
+        for win in windows[:: max(1, len(windows) // 4)]
+    ]
+    times = pass_times({FLOAT: None, INT8: args.model}, sample, args.rounds)
+    moved_arr = np.array(moved) if moved else np.array([np.nan])
+    n_win = len(fs) * len(windows)
+    results: dict[str, Any] = {
+        "model": str(args.model),
+        "model_bytes": args.model.stat().st_size,
+        "frames": len(fs),
+        "windows": n_win,
+        "windows_found_float": found[FLOAT],
+        "windows_found_int8": found[INT8],
+        "windows_both": both,
+        "windows_only_float": only_float,
+        "windows_only_int8": only_int8,
+        "keypoint_move_p50_pct": 100 * float(np.nanmedian(moved_arr)),
+        "keypoint_move_p95_pct": 100 * float(np.nanpercentile(moved_arr, 95)),
+        "tracked_pct": {k: 100 * float(v.mean()) for k, v in tracked.items()},
+        "tracked_disagree_frames": int((tracked[FLOAT] != tracked[INT8]).sum()),
+        "pass_ms": times["ms"],
+        "pass_ratio_x": times["ms"][INT8] / times["ms"][FLOAT],
+    }
+    lines = [
+        f"Candidate `{args.model}` ({args.model.stat().st_size:,} bytes) against the shipped "
+        f"float `pose_detection.onnx` on the large frame set ({len(fs)} frames, "
+        f"{len(windows)} windows each: the whole frame and the search cascade's tiles).",
+        "",
+        "| | float | int8 |",
+        "| --- | ---: | ---: |",
+        f"| windows with a detection (of {n_win}) | {found[FLOAT]} | {found[INT8]} |",
+        f"| found by this one only | {only_float} | {only_int8} |",
+        f"| frames the tracker found someone in | {results['tracked_pct'][FLOAT]:.1f} % "
+        f"| {results['tracked_pct'][INT8]:.1f} % |",
+        f"| ms per detector pass, 1 thread (load {times['load_min']:.1f}-"
+        f"{times['load_max']:.1f}) | {times['ms'][FLOAT]:.2f} | {times['ms'][INT8]:.2f} |",
+        "",
+        f"Both found someone in {both} windows; the int8 detection's farthest keypoint moved "
+        f"{results['keypoint_move_p50_pct']:.1f} % of the float box's height at the median, "
+        f"{results['keypoint_move_p95_pct']:.1f} % at p95. The tracker's found/not-found "
+        f"differed on {results['tracked_disagree_frames']} of {len(fs)} frames. "
+        f"int8 / float per pass: {results['pass_ratio_x']:.2f}.",
+    ]
+    table = "\n".join(lines)
+    print(table)
+    recorder.finish(results, table, write=not args.no_append)
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    sub = ap.add_subparsers(dest="cmd", required=True)
+    w = sub.add_parser("windows", help="calibration windows for the quantizer")
+    w.add_argument("--out", type=Path, default=Path("recordings/int8/detector_windows.npz"))
+    j = sub.add_parser("judge", help="judge an int8 detector against the float one")
+    j.add_argument("model", type=Path)
+    j.add_argument("--rounds", type=int, default=4)
+    j.add_argument("--no-append", action="store_true")
+    args = ap.parse_args()
+    cmd_windows(args) if args.cmd == "windows" else cmd_judge(args)
+
+
+if __name__ == "__main__":
+    main()
