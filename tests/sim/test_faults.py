@@ -501,8 +501,10 @@ def test_a_run_that_kills_its_worker_every_time_is_failed_and_the_sweep_goes_on(
 def test_a_sweep_killed_with_sigkill_resumes_without_loss_to_the_same_results(
     tmp_path: Path, commands: list[Command]
 ) -> None:
-    # Two runs of a standing robot: the second (23 frames) is mid-run when the first ends.
-    spec_path = sweep_spec(tmp_path, "two", '"duration" = [0.4, 1.5]', speed=0.0)
+    # Two runs of a standing robot: the second (60 frames) is mid-run when the first ends.
+    # (At 23 frames it once finished first on a loaded CI host: the two workers start
+    # a second or two apart, so the margin must be longer than that.)
+    spec_path = sweep_spec(tmp_path, "two", '"duration" = [0.4, 4.0]', speed=0.0)
     out = tmp_path / "killed.jsonl"
     args = ["sweep", str(spec_path), "--out", str(out), "--record", "none", *SWEEP_FLAGS]
     sweep = Command.start(args, tmp_path, "killed")
