@@ -23,11 +23,11 @@ head line when both are visible, which averages down their noise.
 from __future__ import annotations
 
 import math
-from collections import deque
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from monopic.features.window import SlidingWindow
 from monopic.pose.skeleton import INDEX, LEFT_SHOULDER, RIGHT_SHOULDER
 
 LEFT_EYE, RIGHT_EYE = INDEX["left_eye"], INDEX["right_eye"]
@@ -116,20 +116,25 @@ class HeadTurnWindow:
     past_s: tuple[float, float] = (0.5, 1.5)  # a check lasts about a second (scenarios/README)
     min_now: int = 2
     min_past: int = 4
-    _samples: deque[tuple[float, float]] = field(default_factory=deque, init=False)
+    _facings: SlidingWindow = field(init=False)
+
+    def __post_init__(self) -> None:
+        self._facings = SlidingWindow(self.past_s[1])
 
     def update(self, timestamp: float, facing: float) -> float:
         """Add this frame's facing (NaN: not seen) and return the turn toward the camera."""
         if math.isfinite(facing):
-            self._samples.append((timestamp, abs(facing)))
-        while self._samples and self._samples[0][0] < timestamp - self.past_s[1] - 1e-9:
-            self._samples.popleft()
-        now = [f for t, f in self._samples if t >= timestamp - self.now_s - 1e-9]
+            self._facings.add(timestamp, abs(facing))
+        t, v, _ = self._facings.arrays()
+        if not len(t):
+            return float("nan")
+        v = v[:, 0]
+        now = v[t >= timestamp - self.now_s - 1e-9]
         far, near = timestamp - self.past_s[1] - 1e-9, timestamp - self.past_s[0] + 1e-9
-        past = [f for t, f in self._samples if far <= t <= near]
+        past = v[(t >= far) & (t <= near)]
         if len(now) < self.min_now or len(past) < self.min_past:
             return float("nan")
         return float(np.median(past) - np.median(now))
 
     def reset(self) -> None:
-        self._samples.clear()
+        self._facings.reset()
