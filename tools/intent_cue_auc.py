@@ -30,21 +30,11 @@ def auc(positive: list[float], negative: list[float]) -> float:
     """P(a positive value > a negative one), ties counted half (Mann-Whitney U / n+ n-)."""
     if not positive or not negative:
         return math.nan
-    values = np.concatenate([positive, negative])
-    order = values.argsort(kind="mergesort")
-    ranks = np.empty(len(values))
-    sorted_values = values[order]
-    # average ranks over ties
-    i = 0
-    while i < len(values):
-        j = i
-        while j + 1 < len(values) and sorted_values[j + 1] == sorted_values[i]:
-            j += 1
-        ranks[order[i : j + 1]] = (i + j) / 2 + 1
-        i = j + 1
-    n_pos = len(positive)
-    u = ranks[:n_pos].sum() - n_pos * (n_pos + 1) / 2
-    return float(u / (n_pos * len(negative)))
+    neg = np.sort(np.asarray(negative, dtype=float))
+    pos = np.asarray(positive, dtype=float)
+    below = np.searchsorted(neg, pos, side="left")  # negatives under each positive
+    tied = np.searchsorted(neg, pos, side="right") - below
+    return float((below + 0.5 * tied).sum() / (len(pos) * len(neg)))
 
 
 def main() -> int:
