@@ -27,7 +27,6 @@ from __future__ import annotations
 import argparse
 import os
 import sys
-import time
 from pathlib import Path
 from typing import Any
 
@@ -35,8 +34,10 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
+from alternate import alternated_ms  # noqa: E402
 from frameset import CALIBRATION, LARGE, FrameSet, build, load  # noqa: E402
 from history import Recorder  # noqa: E402
+from int8_landmarks import track  # noqa: E402
 
 from monopic.pose.anchors import INPUT_SIZE  # noqa: E402
 from monopic.pose.detector import Detection, PoseDetector, letterbox  # noqa: E402
@@ -91,38 +92,21 @@ def best(dets: list[Detection]) -> Detection | None:
     return dets[0] if dets else None
 
 
-def track(fs: FrameSet, detector: PoseDetector) -> np.ndarray:
+def tracked(fs: FrameSet, detector: PoseDetector) -> np.ndarray:
     """Frames the shipped tracker found someone in, with `detector` as its detector."""
     tracker = PoseTracker(TrackerConfig(threads=1))
     tracker.detector = detector
-    found = []
-    for i in range(len(fs)):
-        if i == 0 or fs.sequence[i] != fs.sequence[i - 1]:
-            tracker.reset()
-        r = tracker.process(np.asarray(fs.images[i]), timestamp=float(fs.timestamp[i]))
-        found.append(r.found)
-    return np.array(found)
+    return np.array([lm is not None for lm in track(fs, tracker)["landmarks"]])
 
 
 def pass_times(paths: dict[str, Path | None], tensors: list[np.ndarray], rounds: int) -> dict:
     """Median ms per detector pass of each model on the same windows, alternated."""
     detectors = {k: detector_with(p) for k, p in paths.items()}
-    samples: dict[str, list[float]] = {k: [] for k in detectors}
-    loads = []
-    order = list(detectors)
-    for r in range(rounds):
-        loads.append(os.getloadavg()[0])
-        for k in order if r % 2 == 0 else order[::-1]:
-            d = detectors[k]
-            for t in tensors:
-                t0 = time.perf_counter()
-                d.session.run([d.regressor_name, d.score_name], {d.input_name: t[None]})
-                samples[k].append(1e3 * (time.perf_counter() - t0))
-    return {
-        "ms": {k: float(np.median(v)) for k, v in samples.items()},
-        "load_min": min(loads),
-        "load_max": max(loads),
+    calls = {
+        k: (lambda t, d=d: d.session.run([d.regressor_name, d.score_name], {d.input_name: t[None]}))
+        for k, d in detectors.items()
     }
+    return alternated_ms(calls, tensors, rounds)
 
 
 def cmd_judge(args: argparse.Namespace) -> None:
@@ -153,7 +137,7 @@ def cmd_judge(args: argparse.Namespace) -> None:
                 only_float += 1
             elif q is not None:
                 only_int8 += 1
-    tracked = {k: track(fs, d) for k, d in dets.items()}
+    found_frames = {k: tracked(fs, d) for k, d in dets.items()}
     sample = [
         letterbox(np.asarray(fs.images[i]), win, INPUT_SIZE)[0]
         for i in range(0, len(fs), max(1, len(fs) // 12))
@@ -174,8 +158,8 @@ def cmd_judge(args: argparse.Namespace) -> None:
         "windows_only_int8": only_int8,
         "keypoint_move_p50_pct": 100 * float(np.nanmedian(moved_arr)),
         "keypoint_move_p95_pct": 100 * float(np.nanpercentile(moved_arr, 95)),
-        "tracked_pct": {k: 100 * float(v.mean()) for k, v in tracked.items()},
-        "tracked_disagree_frames": int((tracked[FLOAT] != tracked[INT8]).sum()),
+        "tracked_pct": {k: 100 * float(v.mean()) for k, v in found_frames.items()},
+        "tracked_disagree_frames": int((found_frames[FLOAT] != found_frames[INT8]).sum()),
         "pass_ms": times["ms"],
         "pass_ratio_x": times["ms"][INT8] / times["ms"][FLOAT],
     }

@@ -23,7 +23,6 @@ at least 500 frames. Three steps:
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -33,6 +32,7 @@ import numpy as np
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
+from alternate import alternated_ms  # noqa: E402
 from frameset import CALIBRATION, LARGE, FrameSet, build, load  # noqa: E402
 from history import Recorder  # noqa: E402
 from paired import paired_mean_difference, paired_median_difference  # noqa: E402
@@ -107,21 +107,8 @@ def model_times(
     """Median ms per run of each model on the same crops, alternated (A B B A ...)."""
     sessions = {k: make_session(p, threads, spin=False) for k, p in paths.items()}
     feeds = [{"image": (c.astype(np.float32) / 255.0)[None]} for c in crops]
-    for s in sessions.values():
-        for f in feeds[:5]:
-            s.run(None, f)
-    samples: dict[str, list[float]] = {k: [] for k in sessions}
-    loads = []
-    order = list(sessions)
-    for r in range(rounds):
-        loads.append(os.getloadavg()[0])
-        for k in order if r % 2 == 0 else order[::-1]:
-            for f in feeds:
-                t0 = time.perf_counter()
-                sessions[k].run(None, f)
-                samples[k].append(1e3 * (time.perf_counter() - t0))
-    ms = {k: float(np.median(v)) for k, v in samples.items()}
-    return {"threads": threads, "ms": ms, "load_min": min(loads), "load_max": max(loads)}
+    calls = {k: (lambda feed, s=s: s.run(None, feed)) for k, s in sessions.items()}
+    return {"threads": threads, **alternated_ms(calls, feeds, rounds)}
 
 
 def cmd_judge(args: argparse.Namespace) -> None:
