@@ -12,9 +12,9 @@ landmarks. Two readings:
 
 - `shipped`: monopic.features.head.head_yaw, the angle between the ear and eye lines and
   the shoulder line in (image x, BlazePose z): depths of points across the head;
-- `image`: the head's facing from the camera in the image alone, atan2 of the nose's
-  offset from the ears' midpoint over 10 cm (ear to nose tip, assumed) and the signed
-  eye separation over 63 mm (the adult mean interpupillary distance, Dodgson 2004),
+- `image`: the head's facing from the camera in the image alone
+  (monopic.features.head.head_facing: atan2 of the nose's offset from the ears' midpoint
+  over 10 cm and the signed eye separation over 63 mm), on every still,
   against the truth's head facing from the camera; and the head from the shoulders as
   that facing less the shoulder line's angle (as the shipped reading and phi take it).
 
@@ -43,8 +43,9 @@ from pathlib import Path
 
 import numpy as np
 
-from monopic.features.head import head_yaw
+from monopic.features.head import NOSE, head_facing, head_yaw
 from monopic.pose.search import GroundBand
+from monopic.pose.skeleton import LEFT_SHOULDER, RIGHT_SHOULDER
 from monopic.pose.tracker import PoseTracker, TrackerConfig
 from sim.world.render import GLUnavailableError, SceneRenderer
 from sim.world.scene import Scene
@@ -55,10 +56,6 @@ BODY_DEG = tuple(float(b) for b in range(0, 360, 30))  # 0 facing the camera, 90
 HEAD_DEG = tuple(float(h) for h in range(-60, 61, 10))  # from the shoulders, + left
 LATERAL_M = 0.3  # a little off the optical axis, as a walker near the path
 TRACK_PASSES = 3  # tracking passes on the same still after acquisition
-NOSE_AHEAD_M = 0.10  # ear axis to nose tip (assumed, adult head)
-EYE_SEPARATION_M = 0.063  # adult mean interpupillary distance (Dodgson 2004)
-NOSE, LEFT_EYE, RIGHT_EYE, LEFT_EAR, RIGHT_EAR = 0, 2, 5, 7, 8
-LEFT_SHOULDER, RIGHT_SHOULDER = 11, 12
 BIG_TURN_DEG = 40.0
 
 
@@ -96,13 +93,10 @@ def shipped_reading(still: Still) -> float:
 
 
 def image_facing(still: Still) -> float:
-    """Head facing from the camera (deg, + left) from image x alone."""
-    lm = still.landmarks
-    assert lm is not None
-    ears_mid = (lm[LEFT_EAR, 0] + lm[RIGHT_EAR, 0]) / 2
-    ahead = (lm[NOSE, 0] - ears_mid) / NOSE_AHEAD_M
-    across = (lm[LEFT_EYE, 0] - lm[RIGHT_EYE, 0]) / EYE_SEPARATION_M
-    return math.degrees(math.atan2(ahead, across))
+    """Head facing from the camera (deg, + left) from image x alone: the pipeline's
+    head_facing, read on every still whatever BlazePose's visibility says."""
+    assert still.landmarks is not None and still.visibility is not None
+    return head_facing(still.landmarks, still.visibility, min_visibility=0.0)
 
 
 def image_reading(still: Still) -> float:
