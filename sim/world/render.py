@@ -24,6 +24,7 @@ import numpy as np  # noqa: E402
 
 from monopic.closing import Closing  # noqa: E402
 from sim.world.scene import Scene
+from sim.world.street import SURFACE_GROUP
 
 GLContext = Any  # mujoco's egl/osmesa/glfw GLContext classes share no base class
 
@@ -153,6 +154,18 @@ class SceneRenderer(Closing):
         self._option.geomgroup[:] = [1, 1, 1, 0, 0, 0]  # hide the robot's own body
         self._option.sitegroup[:] = [0] * len(self._option.sitegroup)
         self._rgb = np.empty((self.height, self.width, 3), dtype=np.uint8)
+        self._surfaces = frozenset(np.flatnonzero(model.geom_group == SURFACE_GROUP).tolist())
+
+    def _no_shadows_from_surfaces(self) -> None:
+        """Leave the surfaces flat on the ground out of the sun's shadow map.
+
+        MuJoCo skips decor geoms when it draws the shadow map and only then; the colour
+        passes draw them as before (street.SURFACE_GROUP says why).
+        """
+        for k in range(self._scene.ngeom):
+            g = self._scene.geoms[k]
+            if g.objtype == mujoco.mjtObj.mjOBJ_GEOM and g.objid in self._surfaces:
+                g.category = mujoco.mjtCatBit.mjCAT_DECOR
 
     def _draw(self, markers: tuple[Marker, ...], segmentation: bool) -> np.ndarray:
         if self._mjr is None:
@@ -167,6 +180,7 @@ class SceneRenderer(Closing):
             mujoco.mjtCatBit.mjCAT_ALL,
             self._scene,
         )
+        self._no_shadows_from_surfaces()
         for marker in markers:
             _add_marker(self._scene, marker)
         self._scene.flags[mujoco.mjtRndFlag.mjRND_SEGMENT] = segmentation

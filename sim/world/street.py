@@ -17,9 +17,18 @@ import numpy as np
 from sim.geometry.frames import yaw_quat
 from sim.scenario.spec import RGB, Occluder, RoadLayout
 
+KERB_WIDTH = 0.15  # m
 PAINT_HEIGHT = 0.004  # m, top of the road markings above the asphalt
 SLAB_DEPTH = 0.1  # m, thickness of the road and pavement boxes below z = 0
 GROUND_DEPTH = 0.1  # m, thickness of the grass box whose top is 1 cm below the road
+GRASS_REPEAT = 0.2  # grass texture repeats per m: one period is 2 / 0.2 = 10 m
+GRASS_UNDER = 0.25  # m the grass reaches under the pavements' outer edges (no crack between)
+# Geom group of the surfaces flat on the ground (road, kerbs, pavements, paint, grass).
+# Drawn like group 0, but the renderer leaves them out of the sun's shadow map: a slab
+# whose top is the ground casts no shadow anything could see (the 1 cm step from a
+# pavement down to the grass at most), and on software GL those large boxes were 11 % of
+# a frame's render in the shadow-map pass (bench/simulator.py).
+SURFACE_GROUP = 2
 
 
 def _texture(spec: mujoco.MjSpec, name: str, **kw: object) -> None:
@@ -56,6 +65,7 @@ def _box(
     half: tuple[float, float, float],
     material: str,
     yaw: float = 0.0,
+    group: int = 0,
 ) -> None:
     spec.worldbody.add_geom(
         name=name,
@@ -66,8 +76,27 @@ def _box(
         material=material,
         contype=0,
         conaffinity=0,
-        group=0,
+        group=group,
     )
+
+
+def _surface(
+    spec: mujoco.MjSpec,
+    name: str,
+    centre: tuple[float, float, float],
+    half: tuple[float, float, float],
+    material: str,
+) -> None:
+    """A box lying flat on the ground (slab, paint, grass): drawn, but casts no shadow."""
+    _box(spec, name, centre, half, material, group=SURFACE_GROUP)
+
+
+def _grid_centre(inner: float, outer: float, origin: float, period: float) -> float:
+    """Centre of a piece that starts at `inner`, reaches at least `outer`, and sits a whole
+    number of texture periods from `origin` (`inner` lies between `origin` and `outer`)."""
+    mid = (inner + outer) / 2
+    periods = math.ceil(abs(mid - origin) / period)
+    return origin + math.copysign(periods * period, outer - inner)
 
 
 def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occluder, ...]) -> None:
@@ -101,24 +130,14 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occlude
     )
     asphalt = _material(spec, "asphalt", (1, 1, 1, 1), "asphalt", (0.5, 0.5))
     slabs = _material(spec, "slabs", (1, 1, 1, 1), "slabs", (0.5, 0.5))
-    grass = _material(spec, "grass", (1, 1, 1, 1), "grass", (0.2, 0.2))
+    grass = _material(spec, "grass", (1, 1, 1, 1), "grass", (GRASS_REPEAT, GRASS_REPEAT))
     paint = _material(spec, "paint", (0.92, 0.92, 0.9, 1), specular=0.1)
     kerb = _material(spec, "kerb", (0.72, 0.71, 0.68, 1))
 
-    # The ground is a thin box, not a plane: MuJoCo draws a plane as a dense grid of quads,
-    # which cost software GL 16 ms of a 46 ms frame (most of it in the shadow passes) for
-    # the same image (bench/simulator.py; BENCHMARKS.md, session 3).
-    extent = road.length * 1.5
-    _box(
-        spec,
-        "ground",
-        (0, road.center_y, -0.01 - GROUND_DEPTH / 2),
-        (extent, extent, GROUND_DEPTH / 2),
-        grass,
-    )
+    _add_grass(spec, road, grass)
     half_len = road.length / 2
     y_right, y_left = road.edges
-    _box(
+    _surface(
         spec,
         "road",
         (0, road.center_y, -SLAB_DEPTH / 2),
@@ -126,8 +145,8 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occlude
         asphalt,
     )
     for name, sign, edge in (("south", -1.0, y_right), ("north", 1.0, y_left)):
-        kerb_w = 0.15
-        _box(
+        kerb_w = KERB_WIDTH
+        _surface(
             spec,
             f"kerb_{name}",
             (0, edge + sign * kerb_w / 2, -SLAB_DEPTH / 2),
@@ -135,7 +154,7 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occlude
             kerb,
         )
         pav_centre = edge + sign * (kerb_w + road.pavement_width / 2)
-        _box(
+        _surface(
             spec,
             f"pavement_{name}",
             (0, pav_centre, -SLAB_DEPTH / 2),
@@ -147,7 +166,9 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occlude
     lw = road.line_width / 2
     # Solid edge lines.
     for name, y in (("south", y_right + 0.25), ("north", y_left - 0.25)):
-        _box(spec, f"edge_line_{name}", (0, y, paint_half_h), (half_len, lw, paint_half_h), paint)
+        _surface(
+            spec, f"edge_line_{name}", (0, y, paint_half_h), (half_len, lw, paint_half_h), paint
+        )
     # Dashed separators between lanes, with a gap across the zebra crossing.
     period = road.dash_length + road.dash_gap
     starts = np.arange(-half_len, half_len - road.dash_length, period)
@@ -159,7 +180,7 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occlude
                 road.crosswalk_length / 2 + road.dash_length
             ):
                 continue
-            _box(
+            _surface(
                 spec,
                 f"dash_{lane}_{k}",
                 (xc, y, paint_half_h),
@@ -172,7 +193,7 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occlude
         span = n_bars * 2 * road.stripe_width - road.stripe_width
         y0 = road.center_y - span / 2 + road.stripe_width / 2
         for k in range(n_bars):
-            _box(
+            _surface(
                 spec,
                 f"zebra_{k}",
                 (road.crosswalk_x, y0 + 2 * k * road.stripe_width, paint_half_h),
@@ -184,6 +205,37 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occlude
         _add_buildings(spec, road)
     for k, occ in enumerate(occluders):
         _add_occluder(spec, k, occ)
+
+
+def _add_grass(spec: mujoco.MjSpec, road: RoadLayout, grass: str) -> None:
+    """Grass everywhere off the street, 1 cm below it, out to 1.5 road lengths each way.
+
+    Four boxes around the street rather than one under everything: software GL shaded
+    the grass under every road and pavement pixel again in each pass (12 % of a frame's
+    render, bench/simulator.py). Each piece's centre sits a whole number of texture
+    periods from the street's centre line, so the grass looks exactly as one box's did.
+    A box, not a plane: MuJoCo draws a plane as a dense grid of quads, which cost
+    software GL 16 ms of a 46 ms frame for the same image (BENCHMARKS.md, session 3).
+    """
+    extent = road.length * 1.5
+    period = 2.0 / GRASS_REPEAT
+    z, half_z = -0.01 - GROUND_DEPTH / 2, GROUND_DEPTH / 2
+    y_right, y_left = road.edges
+    reach = KERB_WIDTH + road.pavement_width - GRASS_UNDER  # from a road edge to the grass
+    cy = road.center_y
+    for name, inner, outer in (
+        ("ground_south", y_right - reach, cy - extent),
+        ("ground_north", y_left + reach, cy + extent),
+    ):
+        yc = _grid_centre(inner, outer, cy, period)
+        _surface(spec, name, (0.0, yc, z), (extent, abs(yc - inner), half_z), grass)
+    half_street = max(y_left + reach - cy, cy - (y_right - reach)) + GRASS_UNDER
+    for name, inner, outer in (
+        ("ground_west", -road.length / 2 + GRASS_UNDER, -extent),
+        ("ground_east", road.length / 2 - GRASS_UNDER, extent),
+    ):
+        xc = _grid_centre(inner, outer, 0.0, period)
+        _surface(spec, name, (xc, cy, z), (abs(xc - inner), half_street, half_z), grass)
 
 
 def _facade_texture(spec: mujoco.MjSpec, name: str, wall: RGB) -> None:
@@ -216,7 +268,7 @@ def _add_buildings(spec: mujoco.MjSpec, road: RoadLayout) -> None:
         _facade_texture(spec, f"facade_{i}", c)
         mats.append(_material(spec, f"facade_{i}", (1, 1, 1, 1), f"facade_{i}", (0.4, 1 / 3)))
     y_right, y_left = road.edges
-    setback = 0.15 + road.pavement_width + 1.0
+    setback = KERB_WIDTH + road.pavement_width + 1.0
     half_len = road.length / 2
     for side, sign, edge in (("south", -1.0, y_right), ("north", 1.0, y_left)):
         x = -half_len

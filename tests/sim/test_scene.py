@@ -5,8 +5,11 @@ from __future__ import annotations
 import csv
 import math
 
+import mujoco
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import sim.world.render
 from monopic.camera import CameraModel
@@ -17,6 +20,7 @@ from sim.world.gait import JOINT_FIELDS, Gait, idle_pose, pose_vector
 from sim.world.mannequin import geom_z_extent
 from sim.world.render import GLUnavailableError, Marker, SceneRenderer
 from sim.world.scene import Scene, SceneConfig
+from sim.world.street import GRASS_REPEAT, GRASS_UNDER, build_street
 from tests.paths import DATA
 
 SMALL = CameraModel.from_fov(320, 180, vertical_fov_deg=65.0, mount_height=1.2, pitch_deg=5.0)
@@ -222,3 +226,68 @@ def test_shipped_clip_truth_matches_the_scene() -> None:
     heights = [(float(r[-1]) - float(r[-3])) / clip.height for r in rows[1:]]
     assert min(heights) >= 0.45 and max(heights) <= 0.7
     assert (DATA / "walk_clip.mp4").stat().st_size < 1.5e6
+
+
+def _street_geoms(road: RoadLayout) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """name -> (centre, half size) of every box build_street adds, no GL needed."""
+    spec = mujoco.MjSpec()
+    build_street(spec, road, ())
+    model = spec.compile()
+    return {
+        model.geom(g).name: (model.geom_pos[g].copy(), model.geom_size[g].copy())
+        for g in range(model.ngeom)
+    }
+
+
+def _covered(
+    boxes: list[tuple[np.ndarray, np.ndarray]], x: np.ndarray, y: np.ndarray
+) -> np.ndarray:
+    hit = np.zeros(x.shape, dtype=bool)
+    for (cx, cy, _), (hx, hy, _) in boxes:
+        hit |= (np.abs(x - cx) <= hx) & (np.abs(y - cy) <= hy)
+    return hit
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    center_y=st.floats(-20.0, 20.0),
+    lanes=st.integers(1, 4),
+    lane_width=st.floats(2.5, 4.0),
+    pavement_width=st.floats(1.0, 6.0),
+    length=st.floats(60.0, 400.0),
+)
+def test_grass_lies_only_off_the_street_and_tiles_as_one_box_would(
+    center_y: float, lanes: int, lane_width: float, pavement_width: float, length: float
+) -> None:
+    road = RoadLayout(
+        length=length, lanes=lanes, lane_width=lane_width, center_y=center_y,
+        pavement_width=pavement_width, crosswalk_x=None,
+    )  # fmt: skip
+    geoms = _street_geoms(road)
+    grass = [v for k, v in geoms.items() if k.startswith("ground")]
+    street = [v for k, v in geoms.items() if k.startswith(("road", "kerb", "pavement"))]
+    assert len(grass) == 4
+    period = 2.0 / GRASS_REPEAT
+    for (cx, cy, _), _ in grass:  # the texture's phase: whole periods from the centre line
+        for offset in (cx, cy - center_y):
+            assert abs(offset / period - round(offset / period)) < 1e-6
+    rng = np.random.default_rng(0)
+    extent = 1.5 * length
+    x, y = rng.uniform(-extent, extent, 20000), center_y + rng.uniform(-extent, extent, 20000)
+    assert np.all(_covered(grass, x, y) | _covered(street, x, y))  # no hole down to the sky
+    y_right, y_left = road.edges
+    on_road = (np.abs(x) < length / 2 - GRASS_UNDER) & (y > y_right) & (y < y_left)
+    assert on_road.any() and not _covered(grass, x[on_road], y[on_road]).any()
+
+
+def test_the_pedestrian_still_casts_its_shadow_on_the_road() -> None:
+    """The ground's slabs are left out of the shadow map; the pedestrian is not."""
+    scene = small_scene()
+    with SceneRenderer(scene) as renderer:
+        empty = renderer.render().astype(int)
+        spot = ROBOT.to_world(np.array([3.0, 0.0, 0.0]))
+        scene.set_pedestrian(spot[0], spot[1], ROBOT.yaw + math.pi / 2)
+        image = renderer.render().astype(int)
+        body = renderer.pedestrian_mask()
+    darker = (image.sum(-1) < empty.sum(-1) - 30) & ~body
+    assert darker.sum() > 40  # 62 pixels of shadow beside the 740 of the body
