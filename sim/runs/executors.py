@@ -45,6 +45,9 @@ WORKER_ENV = {
     "OPENBLAS_NUM_THREADS": "1",
     "MKL_NUM_THREADS": "1",
     "LP_NUM_THREADS": "1",  # Mesa's software rasteriser: one thread per worker
+    # OpenCV's own pool (the crops' warps) ignores OMP_NUM_THREADS: without this each of
+    # two workers on two cores ran its warps on two threads, 1.4x the CPU time of one.
+    "OPENCV_FOR_THREADS_NUM": "1",
     # pygame (highway-env) initialises SDL, which catches SIGTERM while it is up and only
     # queues a quit event: a worker stopped then would run on. Keep SIGTERM fatal.
     "SDL_NO_SIGNAL_HANDLERS": "1",

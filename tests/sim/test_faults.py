@@ -395,7 +395,15 @@ def test_sdl_catches_sigterm_unless_the_worker_environment_says_not_to(
     clean = {k: v for k, v in os.environ.items() if k != "SDL_NO_SIGNAL_HANDLERS"}
     result = subprocess.run(
         [sys.executable, "-c", SIGTERM_CAUGHT],
-        env={**clean, "SDL_VIDEODRIVER": "dummy", "SDL_AUDIODRIVER": "dummy", **env},
+        env={
+            **clean,
+            "SDL_VIDEODRIVER": "dummy",
+            "SDL_AUDIODRIVER": "dummy",
+            # pygame prints its banner unless told not to (highway-env's import tells it,
+            # so the test passed only after a test that imported highway-env).
+            "PYGAME_HIDE_SUPPORT_PROMPT": "1",
+            **env,
+        },
         capture_output=True,
         text=True,
         timeout=60,
@@ -761,3 +769,13 @@ def test_sigterm_while_joining_a_cluster_that_does_not_answer_is_143_and_its_lin
     assert seconds < 10 + STOP_BOUND_S, f"exited {seconds:.1f} s after SIGTERM"
     assert sweep.proc.returncode == 143  # not Ray's sys.exit(15)
     assert sweep.last_line() == "monopic sweep: terminated"
+
+
+def test_the_worker_environment_gives_opencv_one_thread() -> None:
+    # Two workers on two cores each ran OpenCV's warps on two threads otherwise.
+    clean = {k: v for k, v in os.environ.items() if k != "OPENCV_FOR_THREADS_NUM"}
+    code = "import cv2; print(cv2.getNumThreads())"
+    result = subprocess.run(
+        [sys.executable, "-c", code], env={**clean, **WORKER_ENV}, capture_output=True, text=True
+    )
+    assert result.stdout.strip() == "1", result.stderr[-500:]
