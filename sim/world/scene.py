@@ -269,8 +269,8 @@ class Scene:
             gait_phase=ped.gait_phase,
             landmarks_world=self.mannequin.landmarks(self.data),
             foot_world=self.mannequin.foot_point(self.data),
-            surface_world=self.mannequin.surface_points(self.model, self.data),
-            top_z=self.mannequin.top_height(self.model, self.data),
+            surface_world=self.mannequin.surface_points(self.data),
+            top_z=self.mannequin.top_height(self.data),
         )
 
     def world_to_robot(self, points_world: np.ndarray) -> np.ndarray:

@@ -208,7 +208,7 @@ class World(Closing):
     def _seen_by(self, body: PedestrianTruth, camera: CameraModel) -> PedestrianTruth:
         """The body's image positions through `camera` (the real, pitched one)."""
         scene = self.scene
-        surface = scene.mannequin.surface_points(scene.model, scene.data)
+        surface = scene.mannequin.surface_points(scene.data)
         box, in_frame = image_box(camera, scene.world_to_robot(surface))
         return replace(
             body,
