@@ -28,6 +28,7 @@ from sim.world.street import SURFACE_GROUP
 
 GLContext = Any  # mujoco's egl/osmesa/glfw GLContext classes share no base class
 
+DECOR = int(mujoco.mjtCatBit.mjCAT_DECOR)
 GL_PACKAGES = ("libegl1", "libgl1-mesa-dri", "libegl-mesa0")
 
 
@@ -162,10 +163,10 @@ class SceneRenderer(Closing):
         MuJoCo skips decor geoms when it draws the shadow map and only then; the colour
         passes draw them as before (street.SURFACE_GROUP says why).
         """
-        for k in range(self._scene.ngeom):
-            g = self._scene.geoms[k]
-            if g.objtype == mujoco.mjtObj.mjOBJ_GEOM and g.objid in self._surfaces:
-                g.category = mujoco.mjtCatBit.mjCAT_DECOR
+        geom, decor, surfaces = int(mujoco.mjtObj.mjOBJ_GEOM), DECOR, self._surfaces
+        for g in self._scene.geoms[: self._scene.ngeom]:
+            if g.objid in surfaces and g.objtype == geom:
+                g.category = decor
 
     def _draw(self, markers: tuple[Marker, ...], segmentation: bool) -> np.ndarray:
         if self._mjr is None:
