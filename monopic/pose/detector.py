@@ -18,6 +18,7 @@ import numpy as np
 from monopic.pose.anchors import INPUT_SIZE, ssd_anchor_centres
 from monopic.pose.search import Window
 from monopic.pose.sessions import DEFAULT_RUNTIME, DETECTOR_FILE, make_session, model_path
+from monopic.pose.warp import warp
 
 MIN_SCORE = 0.5
 NMS_IOU = 0.3
@@ -84,6 +85,8 @@ class PoseDetector:
 def letterbox(image: np.ndarray, win: Window, size: int):
     """The window resized into size x size keeping its aspect (centred, zero padding).
 
+    `image` is RGB or, cheaper to warp, its four-channel form (monopic.pose.warp).
+
     Returns the float32 NHWC-less tensor in [-1, 1] and a function mapping normalised
     [0, 1] tensor coordinates back to frame pixels.
     """
@@ -97,9 +100,7 @@ def letterbox(image: np.ndarray, win: Window, size: int):
     )
     m_idx = m.copy()
     m_idx[:, 2] += 0.5 * scale - 0.5  # sample at pixel centres
-    resized = cv2.warpAffine(
-        image, m_idx, (size, size), flags=cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR
-    )
+    resized = warp(image, m_idx, (size, size), cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR)
     # In place after one scaled pass from uint8: the same values, no temporaries.
     tensor = np.multiply(resized, np.float32(2.0 / 255.0), dtype=np.float32)
     np.subtract(tensor, np.float32(1.0), out=tensor)

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
+from monopic.pose.warp import warp
+
 # MediaPipe's pose graphs enlarge the keypoint-aligned square by 1.25 on each side.
 DEFAULT_SCALE = 1.25
 
@@ -56,19 +58,13 @@ class Region:
         return np.hstack([a, b[:, None]])
 
     def crop(self, image: np.ndarray, size: int) -> np.ndarray:
-        """The region resampled to size x size (zero outside the image)."""
+        """The region resampled to size x size x 3 (zero outside the image); the image is
+        RGB or, cheaper to warp, its four-channel form (monopic.pose.warp)."""
         m = self.crop_to_image(size)
         # warpAffine samples pixel centres: shift by half a pixel on both sides.
         m_idx = m.copy()
         m_idx[:, 2] += m[:, :2] @ np.array([0.5, 0.5]) - 0.5
-        return cv2.warpAffine(
-            image,
-            m_idx,
-            (size, size),
-            flags=cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP,
-            borderMode=cv2.BORDER_CONSTANT,
-            borderValue=(0, 0, 0),
-        )
+        return warp(image, m_idx, (size, size), cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP)
 
     def to_image(self, points: np.ndarray, size: int) -> np.ndarray:
         """Crop coordinates (N, 2) in 0..size to image pixels (N, 2)."""

@@ -33,6 +33,7 @@ from monopic.pose.sessions import (
     check_runtime,
     landmark_file,
 )
+from monopic.pose.warp import four_channel
 
 
 @dataclass(frozen=True)
@@ -121,6 +122,7 @@ class PoseTracker:
         the landmark model's alone and the filters' state is left as it is.
         """
         runs, detect_ms, landmark_ms = 0, 0.0, 0.0
+        image = four_channel(image)  # once a frame; every warp of it is then cheaper
         if region is not None:
             self._region = region
             self._filter.reset()

@@ -1,0 +1,39 @@
+"""The affine resampling both pose models' inputs go through (crop, letterbox).
+
+OpenCV warps a four-channel uint8 image with its vector kernels and a three-channel one
+without: a 256 px crop of a 768x432 frame took 0.27 against 0.70 ms on one core here,
+the same bytes in the colour channels, and the frame's one conversion to four channels
+0.07 ms. So the tracker widens each frame once (`four_channel`) and every warp of it
+reads that; `warp` widens a three-channel image itself when given one.
+"""
+
+from __future__ import annotations
+
+import cv2
+import numpy as np
+
+
+def four_channel(image: np.ndarray) -> np.ndarray:
+    """The RGB uint8 image (H, W, 3) with a fourth channel; a 4-channel image as it is."""
+    if image.ndim == 3 and image.shape[2] == 4:
+        return image
+    if image.ndim != 3 or image.shape[2] != 3:
+        raise ValueError(f"expected an RGB image (H, W, 3), got shape {image.shape}")
+    return cv2.cvtColor(image, cv2.COLOR_RGB2RGBA)
+
+
+def warp(image: np.ndarray, matrix: np.ndarray, size: tuple[int, int], flags: int) -> np.ndarray:
+    """cv2.warpAffine of the image's colour channels into `size` (w, h), zero outside.
+
+    Returns an (h, w, 3) view of the four-channel result (the models' float conversion
+    reads it in one pass).
+    """
+    out = cv2.warpAffine(
+        four_channel(image),
+        matrix,
+        size,
+        flags=flags,
+        borderMode=cv2.BORDER_CONSTANT,
+        borderValue=(0, 0, 0, 0),
+    )
+    return out[..., :3]

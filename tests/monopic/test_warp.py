@@ -1,0 +1,50 @@
+"""monopic.pose.warp: the four-channel warp gives the three-channel warp's bytes."""
+
+from __future__ import annotations
+
+import math
+
+import cv2
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from monopic.pose.warp import four_channel, warp
+
+FLAGS = (cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, cv2.INTER_LINEAR, cv2.INTER_AREA)
+
+
+@settings(max_examples=40, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    angle=st.floats(-math.pi, math.pi),
+    scale=st.floats(0.1, 4.0),
+    x=st.floats(-300.0, 900.0),
+    y=st.floats(-300.0, 600.0),
+    flags=st.sampled_from(FLAGS),
+)
+def test_warping_the_four_channel_frame_gives_the_rgb_warp_byte_for_byte(
+    seed: int, angle: float, scale: float, x: float, y: float, flags: int
+) -> None:
+    image = np.random.default_rng(seed).integers(0, 256, (120, 200, 3), dtype=np.uint8)
+    c, s = math.cos(angle) * scale, math.sin(angle) * scale
+    m = np.array([[c, -s, x], [s, c, y]])
+    expected = cv2.warpAffine(image, m, (64, 48), flags=flags)  # zero border, as before
+    for given_image in (image, four_channel(image)):
+        out = warp(given_image, m, (64, 48), flags)
+        assert out.shape == (48, 64, 3)
+        assert np.array_equal(out, expected)
+
+
+def test_four_channel_keeps_the_colours_and_leaves_a_four_channel_image_alone() -> None:
+    image = np.arange(2 * 3 * 3, dtype=np.uint8).reshape(2, 3, 3)
+    wide = four_channel(image)
+    assert wide.shape == (2, 3, 4) and np.array_equal(wide[..., :3], image)
+    assert four_channel(wide) is wide
+
+
+@pytest.mark.parametrize("shape", [(4, 4), (4, 4, 1), (4, 4, 2)])
+def test_an_image_that_is_not_rgb_is_named(shape: tuple[int, ...]) -> None:
+    with pytest.raises(ValueError, match=r"expected an RGB image \(H, W, 3\)"):
+        four_channel(np.zeros(shape, dtype=np.uint8))
