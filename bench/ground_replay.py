@@ -27,23 +27,18 @@ import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Protocol
+from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
 
-from monopic.camera import CameraModel
 from monopic.errors import UserError
 from monopic.features.ground import GroundMotion, Odometry
 from monopic.features.ground_track import GroundTrackConfig
 from monopic.features.motion import VelocityEstimator
-from monopic.features.record import Features, GroundFeatures
 from monopic.frame import EgoState
 from monopic.output import atomic_path
-from monopic.predict.base import Mode
-from monopic.predict.registry import make_predictor
-from monopic.variants.warning import CollisionWarning
-from monopic.variants.zone import RobotGeometry
+from sim.analysis.ground_replay import Estimator, ground_errors, replay
 from sim.analysis.metrics import FrameCounts, judge_run, summarise
 from sim.runs.result import MAIN, DecisionColumns, RunResult
 from sim.runs.results_file import read_results
@@ -53,18 +48,6 @@ from history import Recorder  # noqa: E402
 
 METHOD = "constant-velocity/ground"
 TITLE = "Ground-motion estimators replayed on a sweep's foot points"
-MAX_GAP = 0.5  # s, FeatureExtractor.max_gap: a longer gap restarts the track
-CAR_MOUNT_FORWARD = 0.8  # m, sim.scenario.families' car camera (not in the result line)
-
-
-class Estimator(Protocol):
-    """The interface both estimators offer (GroundMotion's)."""
-
-    def observe_ego(self, t: float, ego: EgoState) -> None: ...
-    def update(
-        self, t: float, ego: EgoState, foot: tuple[float, float], height: float
-    ) -> tuple[tuple[float, float], tuple[float, float]] | None: ...
-    def reset_track(self) -> None: ...
 
 
 @dataclass
@@ -89,52 +72,6 @@ class FiniteDifferences:
 
     def reset_track(self) -> None:
         self.velocity.reset()
-
-
-def camera(row: RunResult) -> CameraModel:
-    c = row.scenario.camera
-    forward = CAR_MOUNT_FORWARD if row.scale == "car" else 0.0
-    return CameraModel.from_fov(
-        c.width, c.height, c.vertical_fov_deg, c.mount_height, c.pitch_deg, forward
-    )
-
-
-def replay(row: RunResult, estimator: Estimator) -> tuple[list, list]:
-    """Per frame: the warning (None without a pose) and the predicted ground point."""
-    s = row.scenario
-    cam, horizon = camera(row), s.horizon
-    robot = RobotGeometry(width=s.robot_width, length=s.robot_length, front=s.robot_length / 2)
-    warning = CollisionWarning(robot=robot)
-    predictor = make_predictor("constant-velocity", Mode.GROUND)
-    main, truth = row.pipelines[MAIN], row.truth
-    size = (s.camera.width, s.camera.height)
-    warn: list[int | None] = []
-    ground: list[tuple[float, float] | None] = []
-    last = None
-    for k, t in enumerate(truth.t):
-        ego = EgoState(cam, truth.robot_speed[k], 0.0)
-        estimator.observe_ego(t, ego)
-        if last is not None and t - last > MAX_GAP:
-            estimator.reset_track()
-            last = None
-        foot = main.foot[k] if main.found[k] else None
-        if foot is None:
-            warn.append(None)
-            ground.append(None)
-            continue
-        last = t
-        got = estimator.update(t, ego, (foot[0], foot[1]), main.height[k] or 0.0)
-        gf = None if got is None else GroundFeatures(got[0], got[1], cam)
-        feats = Features(t, (foot[0], foot[1]), (foot[0], foot[1]), 0.0, 0.0, 0.0, 0.0, gf)
-        if gf is None:
-            warn.append(0)
-            ground.append(None)
-            continue
-        pred = predictor.predict(feats, horizon)
-        w = warning.assess(feats, pred, Mode.GROUND, size, ego)
-        warn.append(int(w.collision))
-        ground.append(pred.ground)
-    return warn, ground
 
 
 @dataclass
@@ -200,9 +137,7 @@ def judge(rows: list[RunResult], name: str, make: Callable[[], Estimator]) -> Ju
         replayed = replace(logged_cols or DecisionColumns(), warn=warn)
         pipelines = {MAIN: replace(main, decisions={METHOD: replayed})}
         outcomes.append(judge_run(replace(row, pipelines=pipelines), METHOD))
-        for end, fut in zip(ground, row.truth.future, strict=True):
-            if end is not None and fut is not None:
-                errors.append(math.hypot(end[0] - fut[0], end[1] - fut[1]))
+        errors.extend(ground_errors(row, ground))
     return Judged(name, agree / max(total, 1), outcomes, np.array(errors))
 
 

@@ -52,3 +52,21 @@ def test_the_cue_gate_tool_names_a_missing_tree_in_one_line(tmp_path: Path) -> N
     assert r.returncode == 2 and r.stdout == ""
     (line,) = r.stderr.strip().splitlines()
     assert line.startswith(f"intent_cue_gate: {tmp_path / 'none.json'}")
+
+
+def test_decisive_rows_are_those_where_constant_velocity_reaches_the_band_from_outside() -> None:
+    from monopic.cases import Case
+    from monopic.replay.intent_training import LabelledRow, RunRows
+    from monopic.tree.intent import IntentSample
+    from monopic.variants.zone import RobotGeometry
+
+    robot = RobotGeometry(width=0.6, length=0.8, front=0.4)
+
+    def row(y: float, vl: float) -> LabelledRow:
+        s = IntentSample({}, Case.STILL, "stop", (5.0, y), (0.0, vl), (5.0, y))
+        return LabelledRow(s, False, robot, 1.0, 0.0)
+
+    rows = (row(-2.0, 1.5), row(-2.0, 0.2), row(0.1, 0.0), row(2.0, -1.3), row(-2.0, float("nan")))
+    run = RunRows("r", "f", 0, rows, horizon=1.0)
+    kept = intent_cue_auc.decisive_rows([run])
+    assert [s.position[1] * s.velocity[1] for s in kept] == [-3.0, -2.6]  # rows 1 and 4
