@@ -26,20 +26,22 @@ def _threads() -> int:
 
 def test_dropped_recordings_free_their_threads(tmp_path: Path) -> None:
     # rerun keeps a dropped stream's batcher threads and buffers until a cleanup pass; a
-    # sweep worker records every run and drops most of them, so each must be freed.
+    # sweep worker records every run and drops most of them, so each must be freed. The
+    # first recordings may start threads rerun then keeps for all (a full-suite run once
+    # read [8, 9, 9, 9]): the count must not grow after them.
     counts = []
-    for k in range(4):
+    for k in range(6):
         rec = RunRecording(tmp_path / f"r{k}.rrd")
         rec.abort()
         counts.append(_threads())
-    assert counts[-1] <= counts[0], counts
+    assert counts[-1] <= counts[1], counts
     assert not list(tmp_path.iterdir())
     # Kept ones too, blueprint included (rerun makes a stream for it).
     counts = []
-    for k in range(4):
+    for k in range(6):
         rec = RunRecording(tmp_path / f"k{k}.rrd")
         rec.rec.log("features/phi", rr.Scalars(float(k)))
         rec.close()
         counts.append(_threads())
-    assert counts[-1] <= counts[0], counts
+    assert counts[-1] <= counts[1], counts
     assert rows_per_entity(tmp_path / "k3.rrd") == {"/features/phi": 1}  # whole, readable
