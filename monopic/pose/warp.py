@@ -1,10 +1,11 @@
 """The affine resampling both pose models' inputs go through (crop, letterbox).
 
 OpenCV warps a four-channel uint8 image with its vector kernels and a three-channel one
-without: a 256 px crop of a 768x432 frame took 0.27 against 0.70 ms on one core here,
-the same bytes in the colour channels, and the frame's one conversion to four channels
-0.07 ms. So the tracker widens each frame once (`four_channel`) and every warp of it
-reads that; `warp` widens a three-channel image itself when given one.
+without: a rotated 256 px crop of a 768x432 frame took 0.57 against 0.89 ms on one core
+here, the detector's 224 px letterbox of the whole frame 0.24 against 0.41 ms, the same
+bytes in the colour channels, and the frame's one conversion to four channels 0.14 ms
+(bench/crop_warp.py). So the tracker widens each frame once (`four_channel`) and every
+warp of it reads that; `warp` widens a three-channel image itself when given one.
 """
 
 from __future__ import annotations
