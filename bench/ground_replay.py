@@ -25,7 +25,7 @@ import itertools
 import math
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -38,9 +38,9 @@ from monopic.features.ground_track import GroundTrackConfig
 from monopic.features.motion import VelocityEstimator
 from monopic.frame import EgoState
 from monopic.output import atomic_path
-from sim.analysis.ground_replay import Estimator, ground_errors, replay
-from sim.analysis.metrics import FrameCounts, judge_run, summarise
-from sim.runs.result import MAIN, DecisionColumns, RunResult
+from sim.analysis.ground_replay import Estimator, ground_errors, judge_warnings, replay
+from sim.analysis.metrics import FrameCounts, summarise
+from sim.runs.result import MAIN, RunResult
 from sim.runs.results_file import read_results
 
 sys.path.insert(0, str(Path(__file__).resolve().parent))
@@ -134,9 +134,7 @@ def judge(rows: list[RunResult], name: str, make: Callable[[], Estimator]) -> Ju
         logged = logged_cols.warn if logged_cols else [None] * len(warn)
         agree += sum((a or 0) == (b or 0) for a, b in zip(warn, logged, strict=True))
         total += len(warn)
-        replayed = replace(logged_cols or DecisionColumns(), warn=warn)
-        pipelines = {MAIN: replace(main, decisions={METHOD: replayed})}
-        outcomes.append(judge_run(replace(row, pipelines=pipelines), METHOD))
+        outcomes.append(judge_warnings(row, warn, METHOD, logged_cols))
         errors.extend(ground_errors(row, ground))
     return Judged(name, agree / max(total, 1), outcomes, np.array(errors))
 

@@ -29,9 +29,9 @@ from monopic.output import atomic_path
 from monopic.predict.base import Prediction, with_ground_point
 from monopic.tree.intent import START_CROSSING, IntentRules, LeafReading, place
 from monopic.tree.serialise import load_intent_model
-from sim.analysis.ground_replay import PointRule, ReplayFrame, replay
-from sim.analysis.metrics import LEAD_GOAL, RunOutcome, judge_run, paired_recall
-from sim.runs.result import MAIN, DecisionColumns, RunResult
+from sim.analysis.ground_replay import PointRule, ReplayFrame, judge_warnings, replay
+from sim.analysis.metrics import LEAD_GOAL, RunOutcome, paired_recall
+from sim.runs.result import RunResult
 from sim.runs.results_file import read_results
 
 BASELINE = "constant velocity (replayed)"
@@ -80,17 +80,7 @@ def perfect_point(row: RunResult) -> PointRule:
 def outcomes(
     rows: Sequence[RunResult], rule: Callable[[RunResult], PointRule | None], name: str
 ) -> list[RunOutcome]:
-    out = []
-    for row in rows:
-        warn, _ = replay(row, GroundMotion(), rule(row))
-        main = row.pipelines[MAIN]
-        columns = replace(DecisionColumns(), warn=warn)
-        out.append(
-            judge_run(
-                replace(row, pipelines={MAIN: replace(main, decisions={name: columns})}), name
-            )
-        )
-    return out
+    return [judge_warnings(row, replay(row, GroundMotion(), rule(row))[0], name) for row in rows]
 
 
 def table(methods: dict[str, list[RunOutcome]], families: list[str]) -> list[str]:

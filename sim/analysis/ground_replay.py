@@ -10,7 +10,7 @@ estimators this way, tools/intent_ceiling.py the intent rules given the truth's 
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Protocol
 
 import numpy as np
@@ -23,7 +23,8 @@ from monopic.predict.base import Mode, Prediction
 from monopic.predict.registry import make_predictor
 from monopic.variants.warning import CollisionWarning
 from monopic.variants.zone import RobotGeometry
-from sim.runs.result import MAIN, RunResult
+from sim.analysis.metrics import RunOutcome, judge_run
+from sim.runs.result import MAIN, DecisionColumns, RunResult
 
 MAX_GAP = 0.5  # s, FeatureExtractor.max_gap: a longer gap restarts the track
 CAR_MOUNT_FORWARD = 0.8  # m, sim.scenario.families' car camera (not in the result line)
@@ -107,6 +108,18 @@ def replay(
         warn.append(int(w.collision))
         ground.append(pred.ground)
     return warn, ground
+
+
+def judge_warnings(
+    row: RunResult, warn: list[int | None], method: str, columns: DecisionColumns | None = None
+) -> RunOutcome:
+    """The run judged as if `method` had warned `warn` (frame by frame), with the sweep's
+    own metrics; `columns` carries the method's other recorded columns, if any."""
+    main = row.pipelines[MAIN]
+    replayed = replace(columns or DecisionColumns(), warn=warn)
+    return judge_run(
+        replace(row, pipelines={MAIN: replace(main, decisions={method: replayed})}), method
+    )
 
 
 def ground_errors(row: RunResult, ground: list[tuple[float, float] | None]) -> list[float]:

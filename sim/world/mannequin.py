@@ -686,10 +686,3 @@ def geom_z_extent(
 ) -> tuple[np.ndarray, np.ndarray]:
     """Lowest and highest world z of each geom (spheres, capsules, ellipsoids, boxes)."""
     return GeomShapes.of(model, geoms, n=1).z_extent(data)
-
-
-def geom_surface_points(
-    model: mujoco.MjModel, data: mujoco.MjData, geoms: np.ndarray, n: int = 98
-) -> np.ndarray:
-    """World points (len(geoms) * n, 3) on the surfaces of the given geoms, geom by geom."""
-    return GeomShapes.of(model, geoms, n).surface_points(data)

@@ -26,8 +26,9 @@ GRASS_UNDER = 0.25  # m the grass reaches under the pavements' outer edges (no c
 # Geom group of the surfaces flat on the ground (road, kerbs, pavements, paint, grass).
 # Drawn like group 0, but the renderer leaves them out of the sun's shadow map: a slab
 # whose top is the ground casts no shadow anything could see (the 1 cm step from a
-# pavement down to the grass at most), and on software GL those large boxes were 11 % of
-# a frame's render in the shadow-map pass (bench/simulator.py).
+# pavement down to the grass at most), and on software GL drawing those large boxes into
+# it cost 4-11 % of a frame's render (with _add_grass's change, 0.84 of the render time
+# in all: bench/render_ab.py, docs/benchmarks.md session 10).
 SURFACE_GROUP = 2
 
 
@@ -145,15 +146,14 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occlude
         asphalt,
     )
     for name, sign, edge in (("south", -1.0, y_right), ("north", 1.0, y_left)):
-        kerb_w = KERB_WIDTH
         _surface(
             spec,
             f"kerb_{name}",
-            (0, edge + sign * kerb_w / 2, -SLAB_DEPTH / 2),
-            (half_len, kerb_w / 2, SLAB_DEPTH / 2),
+            (0, edge + sign * KERB_WIDTH / 2, -SLAB_DEPTH / 2),
+            (half_len, KERB_WIDTH / 2, SLAB_DEPTH / 2),
             kerb,
         )
-        pav_centre = edge + sign * (kerb_w + road.pavement_width / 2)
+        pav_centre = edge + sign * (KERB_WIDTH + road.pavement_width / 2)
         _surface(
             spec,
             f"pavement_{name}",
@@ -212,7 +212,7 @@ def _add_grass(spec: mujoco.MjSpec, road: RoadLayout, grass: str) -> None:
 
     Four boxes around the street rather than one under everything: software GL shaded
     the grass under every road and pavement pixel again in each pass (12 % of a frame's
-    render, bench/simulator.py). Each piece's centre sits a whole number of texture
+    render; docs/benchmarks.md, session 10). Each piece's centre sits a whole number of texture
     periods from the street's centre line, so the grass looks exactly as one box's did.
     A box, not a plane: MuJoCo draws a plane as a dense grid of quads, which cost
     software GL 16 ms of a 46 ms frame for the same image (BENCHMARKS.md, session 3).
