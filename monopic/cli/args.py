@@ -29,6 +29,20 @@ def non_negative_float(text: str) -> float:
     return value
 
 
+def parameter_limit(text: str) -> tuple[str, float]:
+    """'NAME=VALUE' with a finite number: a swept parameter and a limit on it."""
+    name, sep, value = text.partition("=")
+    if not sep or not name.strip():
+        raise argparse.ArgumentTypeError(f"expected PARAM=VALUE, got {text!r}")
+    try:
+        number = float(value)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{name}: expected a number, got {value!r}") from None
+    if not math.isfinite(number):
+        raise argparse.ArgumentTypeError(f"{name}: must be finite, got {value!r}")
+    return name.strip(), number
+
+
 def positive_int(text: str) -> int:
     try:
         value = int(text)

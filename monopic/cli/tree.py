@@ -9,6 +9,7 @@ from monopic.cli.args import (
     non_negative_float,
     output_file,
     output_folder,
+    parameter_limit,
     positive_float,
     positive_int,
 )
@@ -167,6 +168,16 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         help="ground mode: validate on this family (repeatable; instead of the hash share)",
     )
     t.add_argument(
+        "--validate-above",
+        action="append",
+        default=[],
+        type=parameter_limit,
+        metavar="PARAM=VALUE",
+        help="ground mode: validate on the runs with this swept parameter at or above VALUE "
+        "(repeatable: any of them), e.g. pedestrian.speed=1.35, so that the rules are "
+        "chosen on walkers beyond those trained on, as the judged draws are",
+    )
+    t.add_argument(
         "--exclude-family",
         action="append",
         default=[],
@@ -302,7 +313,13 @@ def _train_ground(args: argparse.Namespace) -> int:
         raise UserError(
             f"run {dup!r} is in two datasets given (it could be trained on and validated)"
         )
-    split = split_runs(runs, args.validation_share, args.validate_family, args.exclude_family)
+    split = split_runs(
+        runs,
+        args.validation_share,
+        args.validate_family,
+        args.exclude_family,
+        dict(args.validate_above),
+    )
     attributes = [a for a in INTENT_ATTRIBUTES if a not in args.without]
     if not attributes:
         raise UserError("--without: every feature left out; the tree needs at least one")

@@ -564,3 +564,49 @@ def test_the_shipped_ground_tree_is_what_its_card_says() -> None:
     assert p["validation"]["runs"].startswith("31/32") and "2/41" in p["validation"]["runs"]
     predictor = make_predictor("intent-tree", Mode.GROUND)  # no file: the shipped tree
     assert isinstance(predictor, IntentTreePredictor) and predictor.model.tree == model.tree
+
+
+def test_the_split_can_validate_above_the_training_ranges() -> None:
+    runs = [
+        replace(run, params={"pedestrian.speed": 1.1 + 0.05 * k, "robot.speed": 2.0})
+        for k, run in enumerate(_runs([("kerb", s) for s in range(8)]))
+    ]
+    split = split_runs(runs, validate_above={"pedestrian.speed": 1.3})
+    assert [r.params["pedestrian.speed"] for r in split.validation] == pytest.approx(
+        [1.3, 1.35, 1.4, 1.45]
+    )
+    assert all(r.params["pedestrian.speed"] < 1.3 for r in split.train)
+    either = split_runs(runs, validate_above={"pedestrian.speed": 1.4, "robot.speed": 3.0})
+    assert len(either.validation) == 2
+    with pytest.raises(UserError, match=r"run kerb/0: parameter 'lane' = None: not a swept number"):
+        split_runs(runs, validate_above={"lane": 3.0})
+    with pytest.raises(UserError, match="not both"):
+        split_runs(runs, validation_families=["kerb"], validate_above={"robot.speed": 1.0})
+    with pytest.raises(UserError, match="0 validation runs"):
+        split_runs(runs, validate_above={"pedestrian.speed": 9.0})
+
+
+def test_validate_above_is_checked_on_the_command_line(
+    dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    with pytest.raises(SystemExit) as stop:
+        main([*_train(dataset, tmp_path), "--validate-above", "pedestrian.speed"])
+    assert stop.value.code == 2
+    assert "expected PARAM=VALUE, got 'pedestrian.speed'" in capsys.readouterr().err
+    assert main([*_train(dataset, tmp_path), "--validate-above", "pedestrian.speed=1.3"]) == 2
+    assert "parameter 'pedestrian.speed' = None" in one_line_error(capsys)
+
+
+def test_no_release_bound_counts_as_no_lead_in_hand() -> None:
+    def option(release: float, false_alarms: int) -> RuleOption:
+        return RuleOption(
+            IntentRules(hold_back_support=0.5, release_s=release),
+            0.0,
+            None,  # type: ignore[arg-type]
+            WarningCount(0, false_alarms, 10, 100),
+            RunCount(10, 4, 6, 1, (("a", 4),)),
+        )
+
+    cv = option(1.1, 0).runs
+    # Equal on runs: a bounded hold-back keeps lead in hand, no bound keeps none.
+    assert choose_rules([option(math.inf, 0), option(1.1, 5)], cv).rules.release_s == 1.1
