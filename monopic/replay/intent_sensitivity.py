@@ -121,11 +121,6 @@ class Sensitivity:
     runs: int
 
 
-def _value(run: RunRows, key: str) -> float | None:
-    v = run.params.get(key)
-    return float(v) if isinstance(v, int | float) else None
-
-
 def sensitivity(
     runs: Sequence[RunRows],
     trees: Mapping[str, IntentTreeModel],
@@ -146,7 +141,7 @@ def sensitivity(
     replayed += [replay(name, model, runs, horizon) for name, model in trees.items()]
     by_value: dict[str, dict[float, dict[str, Cell]]] = {}
     for key in keys:
-        values = sorted({v for r in runs if (v := _value(r, key)) is not None})
+        values = sorted({v for r in runs if (v := r.number(key)) is not None})
         if not values:
             raise UserError(f"--by {key}: no run of the data sets it (see the runs' parameters)")
         if len(values) > MAX_VALUES:
@@ -157,12 +152,12 @@ def sensitivity(
             )
         by_value[key] = {
             value: {
-                p.name: judge_group(p, runs, [_value(r, key) == value for r in runs])
+                p.name: judge_group(p, runs, [r.number(key) == value for r in runs])
                 for p in replayed
             }
             for value in values
         }
-    off = [all(_value(r, k) == v for k, v in BODY_CUES_OFF.items()) for r in runs]
+    off = [all(r.number(k) == v for k, v in BODY_CUES_OFF.items()) for r in runs]
     on = [not x for x in off]
     return Sensitivity(
         tuple(p.name for p in replayed),

@@ -119,6 +119,11 @@ class RunRows:
     def near_miss(self) -> bool:
         return self.kind == "near-miss" and not self.collision_run
 
+    def number(self, key: str) -> float | None:
+        """The run's swept parameter `key` as a number; None if unset or not a number."""
+        v = self.params.get(key)
+        return float(v) if isinstance(v, int | float) and not isinstance(v, bool) else None
+
 
 def _number(text: str, where: str, column: str) -> float:
     if text.strip() == "":
@@ -345,11 +350,11 @@ def _above(run: RunRows, limits: Mapping[str, float]) -> bool:
     """Any of the run's swept parameters at or above its limit; UserError if a run lacks one."""
     out = False
     for name, limit in limits.items():
-        value = run.params.get(name)
-        if isinstance(value, bool) or not isinstance(value, int | float):
+        value = run.number(name)
+        if value is None:
             raise UserError(
-                f"run {run.run}: parameter {name!r} = {value!r}: not a swept number "
-                "(runs.csv, column parameters)"
+                f"run {run.run}: parameter {name!r} = {run.params.get(name)!r}: not a swept "
+                "number (runs.csv, column parameters)"
             )
         out = out or value >= limit
     return out
