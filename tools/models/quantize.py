@@ -9,7 +9,10 @@ is NOT shipped unless the judge says it keeps the float model's landmark error (
 
     .venv-models/bin/python tools/models/quantize.py --crops recordings/int8/calibration.npz \
         --out recordings/int8/pose_landmark_full_int8.onnx [--method minmax|percentile|entropy]
-        [--deep-only PX]
+        [--deep-only PX] [--keep-outputs]
+
+--keep-outputs keeps each output's nodes back to its last convolution in float (a uint8
+landmark output would step by about a pixel; session 12: it did not help).
 
 --deep-only PX quantizes only the convolutions whose output is at most PX pixels on a side
 (the deep, many-channel layers, where int8 kernels gain most), keeping the early
@@ -91,6 +94,21 @@ def _head_convs(model: onnx.ModelProto) -> set[str]:
     return heads
 
 
+def _output_tails(model: onnx.ModelProto) -> list[str]:
+    """Each graph output's producing nodes back to and including its last convolution: a
+    uint8 landmark output steps by about a pixel, so these stay float."""
+    producer = {o: n for n in model.graph.node for o in n.output}
+    tails = []
+    for output in model.graph.output:
+        node = producer.get(output.name)
+        while node is not None:
+            tails.append(node.name)
+            if node.op_type == "Conv":
+                break
+            node = producer.get(node.input[0])
+    return tails
+
+
 class Crops(CalibrationDataReader):
     """The calibration crops, one at a time, scaled as the model expects: u8 / 255 for the
     landmark model (input `image`), u8 / 127.5 - 1 for the detector."""
@@ -117,6 +135,11 @@ def main() -> int:
     ap.add_argument("--deep-only", type=int, default=0, help="quantize only convs <= PX wide")
     ap.add_argument("--detector", action="store_true", help="the detector, not the landmarks")
     ap.add_argument("--keep-heads", action="store_true", help="detector: output convs in float")
+    ap.add_argument(
+        "--keep-outputs",
+        action="store_true",
+        help="landmarks: the nodes from each output's last convolution on stay float",
+    )
     args = ap.parse_args()
     if not args.crops.is_file():
         raise SystemExit(f"quantize: --crops {args.crops}: no such file")
@@ -136,6 +159,8 @@ def main() -> int:
         exclude += [n.name for n in depthwise]
         if args.keep_heads:  # the six output convolutions (boxes, keypoints, scores)
             exclude += [n.name for n in convs if n.name in _head_convs(model)]
+    if args.keep_outputs:
+        exclude += _output_tails(model)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
         src = Path(tmp) / "float32.onnx"
