@@ -65,6 +65,19 @@ def test_the_perfect_point_is_the_true_future() -> None:
     assert p is not None and p.ground == pytest.approx((5.5, -0.4)) and p.case is not None
 
 
+def test_the_true_velocity_point_extrapolates_the_truths_own_motion_from_the_foot_point() -> None:
+    # The truth: 0.1 m nearer and 0.08 m further left over a 0.1 s frame while the robot
+    # drives at 1 m/s: the walker's own velocity is (0, 0.8) m/s in the robot's axes.
+    truth = SimpleNamespace(
+        t=[0.0, 0.1], forward=[6.1, 6.0], lateral=[-3.08, -3.0], robot_speed=[1.0, 1.0]
+    )
+    row = SimpleNamespace(scenario=SimpleNamespace(horizon=1.0), truth=truth)
+    rule = intent_ceiling.true_velocity_point(row)
+    assert rule(frame(0, (6.0, -2.9), (0.0, 1.4))) is None  # no frame before: no velocity
+    p = rule(frame(1, (6.0, -2.9), (0.0, 1.4)))  # the track says 1.4 m/s: not used
+    assert p is not None and p.ground == pytest.approx((6.0, -2.1))  # from the foot point
+
+
 def test_a_missing_results_file_is_one_line(tmp_path: Path) -> None:
     r = subprocess.run(
         [sys.executable, str(TOOL), str(tmp_path / "none.jsonl")],

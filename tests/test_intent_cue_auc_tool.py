@@ -70,3 +70,34 @@ def test_decisive_rows_are_those_where_constant_velocity_reaches_the_band_from_o
     run = RunRows("r", "f", 0, rows, horizon=1.0)
     kept = intent_cue_auc.decisive_rows([run])
     assert [s.position[1] * s.velocity[1] for s in kept] == [-3.0, -2.6]  # rows 1 and 4
+
+
+def test_family_medians_split_the_decisive_rows_by_what_lies_ahead() -> None:
+    from monopic.cases import Case
+    from monopic.replay.intent_training import LabelledRow, RunRows
+    from monopic.tree.intent import IntentSample
+    from monopic.variants.zone import RobotGeometry
+
+    robot = RobotGeometry(width=0.6, length=0.8, front=0.4)
+
+    def row(t: float, intent: str, speed: float, acc: float, y: float = -2.0) -> LabelledRow:
+        values = {"speed": speed, "acceleration": acc}
+        s = IntentSample(values, Case.STILL, intent, (5.0, y), (0.0, 1.5), (5.0, y))
+        return LabelledRow(s, False, robot, 1.0, 0.0, time=t)
+
+    stops = RunRows(
+        "a", "kerb", 0, (row(2.0, "stop", 0.9, 1.2), row(2.2, "turn away", 1.1, 0.8)), 1.0
+    )
+    walks = RunRows(
+        "b", "kerb", 1,
+        (row(3.0, "keep going", 1.3, 0.1), row(3.1, "keep going", 1.3, 0.2, y=0.1)),  # in band
+        1.0,
+    )  # fmt: skip
+    got = [g[:6] for g in intent_cue_auc.family_medians([stops, walks])]
+    assert got == [("kerb", False, 1, 3.0, 1.3, 0.1), ("kerb", True, 2, 2.1, 1.0, 1.0)]
+    truth = {"a": {1.8: 0.9, 2.0: 0.8, 2.2: 0.7}, "b": {3.0: 1.3}}  # b: nothing 0.2 s back
+    walk, stop = intent_cue_auc.family_medians([stops, walks], truth)
+    assert walk[6] == 1.3 and math.isnan(walk[7])
+    assert stop[6] == pytest.approx(0.75)  # the true speeds 0.8 and 0.7
+    assert stop[7] == pytest.approx(-0.5)  # both slowing by 0.1 m/s over 0.2 s
+    assert stop[8] == walk[8] == 1.5  # the track's speed: |(0, 1.5)|

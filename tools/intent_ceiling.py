@@ -7,8 +7,10 @@ runs warned at most a third of constant velocity's, recall@1s no more than 3 poi
 lower). Is the reading the limit, or the rules themselves? This replays a sweep's own
 foot points through the shipped ground track and the real warning (sim.analysis.
 ground_replay) with the rules fed the truth's intent label of each frame, which no
-pipeline has, and with the true future point itself. Nothing here is tuned or shipped:
-it bounds what any tree with these rules could do on those runs.
+pipeline has, with the truth's current velocity in place of the Kalman track's (session
+12: how much of constant velocity's near-miss warnings is its lag), and with the true
+future point itself. Nothing here is tuned or shipped: it bounds what any tree with these
+rules, or any better velocity estimate, could do on those runs.
 
     .venv/bin/python tools/intent_ceiling.py RESULTS.jsonl [--tree monopic/tree/ground_tree.json]
         [--out docs/intent/ceiling.md]
@@ -73,6 +75,34 @@ def perfect_point(row: RunResult) -> PointRule:
         if end is None:
             return None
         return with_ground_point(f.features, f.constant_velocity.case, horizon, tuple(end))
+
+    return point
+
+
+def true_velocity_point(row: RunResult) -> PointRule:
+    """Constant velocity from the pipeline's own foot point with the truth's current
+    velocity instead of the Kalman track's: how much of constant velocity's near-miss
+    warnings is the track's lag, not the walker's intent (session 12). The velocity is
+    the truth's position change over the last frame plus the robot's own travel, in the
+    robot's axes: exact for a robot driving straight, as in every intent family."""
+    horizon, truth = row.scenario.horizon, row.truth
+
+    def point(f: ReplayFrame) -> Prediction | None:
+        k = f.k
+        if k < 1:
+            return None
+        t0, t1 = truth.t[k - 1], truth.t[k]
+        x0, x1 = truth.forward[k - 1], truth.forward[k]
+        y0, y1 = truth.lateral[k - 1], truth.lateral[k]
+        speed = truth.robot_speed[k]
+        if None in (t0, t1, x0, x1, y0, y1, speed) or not t1 > t0:
+            return None
+        dt = t1 - t0
+        vf, vl = (x1 - x0) / dt + speed, (y1 - y0) / dt
+        g = f.features.ground
+        assert g is not None
+        at = (g.position[0] + vf * horizon, g.position[1] + vl * horizon)
+        return with_ground_point(f.features, f.constant_velocity.case, horizon, at)
 
     return point
 
@@ -149,6 +179,7 @@ def main(argv: list[str] | None = None) -> int:
                 lambda row: oracle_rule(row, bound, True, True),
             )
         )
+    plans.append(("constant velocity, the truth's current velocity", true_velocity_point))
     plans.append(("true future point", perfect_point))
     for name, rule in plans:
         print(f"replaying {len(rows)} runs: {name}", file=sys.stderr, flush=True)

@@ -13,20 +13,27 @@ of it), and adds "hold" (stop or turn away against the rest), the reading the in
 rules need there (docs/intent/ceiling.md).
 
     .venv/bin/python tools/intent_cue_auc.py recordings/intent/train-s9 recordings/intent/train-b-s9
-        [--decisive]
+        [--decisive | --by-family]
+
+`--by-family` prints, per family, the decisive rows' medians of time into the run, speed
+and acceleration, split by whether a stop or turn away lies ahead (session 12: the
+near-miss walkers of the families' default run-up are still starting when the warning
+is decided).
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import sys
+from collections.abc import Mapping
 from pathlib import Path
 
 import numpy as np
 
 from monopic.errors import UserError
-from monopic.replay.intent_training import RunRows, read_dataset
+from monopic.replay.intent_training import LabelledRow, RunRows, read_dataset
 from monopic.tree.intent import INTENT_ATTRIBUTES, INTENTS, ZONE_REACH, IntentSample
 
 STANDING_M_S = 0.3
@@ -47,9 +54,10 @@ def auc(positive: list[float], negative: list[float]) -> float:
 HOLDS = ("stop", "turn away")
 
 
-def decisive_rows(runs: list[RunRows]) -> list[IntentSample]:
-    """Rows where a warning is decided: the walker outside the robot's swept band (of the
-    robot's width), constant velocity's point one horizon ahead within ZONE_REACH of it."""
+def decisive(runs: list[RunRows]) -> list[tuple[RunRows, LabelledRow]]:
+    """Rows where a warning is decided, with their run: the walker outside the robot's
+    swept band (of the robot's width), constant velocity's point one horizon ahead within
+    ZONE_REACH of it."""
     out = []
     for run in runs:
         for row in run.rows:
@@ -59,7 +67,62 @@ def decisive_rows(runs: list[RunRows]) -> list[IntentSample]:
                 continue
             half = row.robot.width / 2
             if abs(y) > half and abs(y + vl * run.horizon) < half + ZONE_REACH:
-                out.append(s)
+                out.append((run, row))
+    return out
+
+
+def decisive_rows(runs: list[RunRows]) -> list[IntentSample]:
+    """The samples of `decisive`."""
+    return [row.sample for _, row in decisive(runs)]
+
+
+Medians = tuple[str, bool, int, float, float, float, float, float, float]
+TRUE_ACC_S = 0.2  # s: the truth's speed change over this much before the frame
+
+
+def true_speeds(folder: Path, run: str) -> dict[float, float]:
+    """The truth's walking speed (m/s) at each frame time of a dataset run."""
+    path = folder / "truth" / f"{run}.jsonl"
+    try:
+        lines = path.read_text(encoding="utf-8").splitlines()
+        return {round(t["time"], 3): float(t["speed"]) for t in map(json.loads, lines)}
+    except (OSError, ValueError, KeyError, TypeError) as err:
+        raise UserError(f"{path}: cannot read the truth's speed: {err}") from None
+
+
+def family_medians(
+    runs: list[RunRows], truth: Mapping[str, Mapping[float, float]] | None = None
+) -> list[Medians]:
+    """Per family and reading (stop or turn away ahead, or not), on the decisive rows: the
+    row count and the medians of the time into the run (s), the pipeline's window speed
+    (m/s) and acceleration along the walk (m/s^2), and, from `truth` (run -> time ->
+    true speed), the true speed and its change over the last TRUE_ACC_S (NaN without),
+    and last the speed of the Kalman track constant velocity extrapolates (m/s).
+    Shows whether a walker still starting up when the warning is decided can show a
+    slowing cue at all, and what the pipeline's window (centred about 0.5 s back) reads
+    of it (session 12)."""
+    groups: dict[tuple[str, bool], list[tuple[float, ...]]] = {}
+    for run, row in decisive(runs):
+        v = row.sample.values
+        speeds = (truth or {}).get(run.run, {})
+        now = speeds.get(round(row.time, 3), math.nan)
+        before = speeds.get(round(row.time - TRUE_ACC_S, 3), math.nan)
+        key = (run.family, row.sample.intent in HOLDS)
+        groups.setdefault(key, []).append(
+            (
+                row.time,
+                v.get("speed", math.nan),
+                v.get("acceleration", math.nan),
+                now,
+                (now - before) / TRUE_ACC_S,
+                math.hypot(*row.sample.velocity),
+            )
+        )
+    out = []
+    for (family, hold), values in sorted(groups.items()):
+        a = np.asarray(values, dtype=float)
+        med = [float(np.nanmedian(c)) if np.isfinite(c).any() else math.nan for c in a.T]
+        out.append((family, hold, len(values), *med))
     return out
 
 
@@ -67,14 +130,39 @@ def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("datasets", nargs="+", type=Path, help="dataset folders (monopic dataset)")
     ap.add_argument("--decisive", action="store_true", help="only rows where a warning is decided")
+    ap.add_argument(
+        "--by-family",
+        action="store_true",
+        help="instead: per family, medians of time, speed and acceleration on decisive rows",
+    )
     args = ap.parse_args()
     runs = []
+    truth: dict[str, dict[float, float]] = {}
     for folder in args.datasets:
         try:
-            runs += read_dataset(folder)
+            these = read_dataset(folder)
+            if args.by_family:
+                truth.update({r.run: true_speeds(folder, r.run) for r in these})
         except (OSError, ValueError, UserError) as err:
             print(f"intent_cue_auc: {err}", file=sys.stderr)
             return 2
+        runs += these
+    if args.by_family:
+        print(f"{len(runs)} runs; decisive rows per family, medians. Speed and acceleration:")
+        print("the pipeline's 1 s window, read about 0.5 s back; true acceleration: over the")
+        print(f"last {TRUE_ACC_S} s; track speed: the Kalman track constant velocity extrapolates")
+        print()
+        print(
+            "| family | stop or turn away ahead | rows | time into run | speed | acceleration"
+            " | true speed | true acceleration | track speed |"
+        )
+        print("| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: |")
+        for family, hold, n, t, speed, acc, true, true_acc, track in family_medians(runs, truth):
+            print(
+                f"| {family} | {'yes' if hold else 'no'} | {n} | {t:.2f} s | {speed:.2f} m/s"
+                f" | {acc:+.2f} m/s² | {true:.2f} m/s | {true_acc:+.2f} m/s² | {track:.2f} m/s |"
+            )
+        return 0
     rows = decisive_rows(runs) if args.decisive else [r.sample for run in runs for r in run.rows]
     which = "decisive rows" if args.decisive else "rows"
     print(f"{len(runs)} runs, {len(rows)} {which}; AUC of each feature alone, intent against rest")
