@@ -39,7 +39,7 @@ from monopic.features.motion import VelocityEstimator
 from monopic.frame import EgoState
 from monopic.output import atomic_path
 from sim.analysis.ground_replay import Estimator, ground_errors, judge_warnings, replay
-from sim.analysis.metrics import FrameCounts, summarise
+from sim.analysis.metrics import LEAD_GOAL, FrameCounts, summarise
 from sim.runs.result import MAIN, RunResult
 from sim.runs.results_file import read_results
 
@@ -102,7 +102,24 @@ class Judged:
             "error_p90_m": float(np.percentile(e, 90)),
             "error_p99_m": float(np.percentile(e, 99)),
             "error_over_10m_pct": float(100 * np.mean(e > 10)),
+            "warned_by_family": {k: list(v) for k, v in self.by_family().items()},
         }
+
+    def by_family(self) -> dict[str, tuple[int, int]]:
+        """Per family: (runs warned, runs) — collision runs warned 1 s ahead, or near-miss
+        runs warned at all. A near miss the track's lag causes shows in some families
+        and not others (docs/intent/ground-tree.md, session 12)."""
+        out: dict[str, tuple[int, int]] = {}
+        for o in self.outcomes:
+            if o.near_miss:
+                hit = bool(o.warned)
+            elif o.collision_run:
+                hit = o.lead is not None and o.lead >= LEAD_GOAL
+            else:
+                continue
+            warned, runs = out.get(o.family, (0, 0))
+            out[o.family] = (warned + hit, runs + 1)
+        return dict(sorted(out.items()))
 
     def row(self) -> str:
         sm = summarise(METHOD, self.outcomes)
@@ -212,6 +229,18 @@ def main() -> None:
         judged.append(judge(rows, name, make))
         lines.append(judged[-1].row())
         print(lines[-1], file=sys.stderr)
+    families = sorted({f for j in judged for f in j.by_family()})
+    lines += [
+        "",
+        "Per family: collision runs warned 1 s ahead, or near-miss runs warned at all.",
+        "",
+        "| estimator | " + " | ".join(families) + " |",
+        "| --- |" + " ---: |" * len(families),
+    ]
+    for j in judged:
+        mine = j.by_family()
+        cells = [f"{mine[f][0]}/{mine[f][1]}" if f in mine else "-" for f in families]
+        lines.append(f"| {j.name} | " + " | ".join(cells) + " |")
     if args.plot:
         plot(judged, args.plot, f"{len(rows)} runs of {args.results.name}, {METHOD}")
         lines += ["", f"![error distributions]({args.plot})"]

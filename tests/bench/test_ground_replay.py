@@ -1,0 +1,38 @@
+"""bench/ground_replay.py: the per-family table counts as the sweep's metrics do."""
+
+from __future__ import annotations
+
+import sys
+
+import numpy as np
+
+from sim.analysis.metrics import FrameCounts, RunOutcome
+from tests.paths import ROOT
+
+sys.path.insert(0, str(ROOT / "bench"))
+import ground_replay  # noqa: E402
+
+
+def outcome(
+    family: str, kind: str, collision: bool, warned: bool, onset: float | None
+) -> RunOutcome:
+    return RunOutcome(
+        id=f"{family}/{onset}", family=family, kind=kind, scale="small", case=5,
+        robot_speed=1.0, horizon=1.5, collision_run=collision,
+        contact_time=4.0 if collision else None, warned=warned, onset=onset,
+        onset_latency=onset, frames=FrameCounts(),
+    )  # fmt: skip
+
+
+def test_by_family_counts_collisions_warned_a_second_ahead_and_near_misses_warned() -> None:
+    outs = [
+        outcome("cross", "collision", True, True, 2.5),  # 1.5 s ahead: counts
+        outcome("cross", "collision", True, True, 3.5),  # 0.5 s ahead: does not
+        outcome("cross", "collision", True, False, None),  # never warned
+        outcome("kerb", "near-miss", False, True, None),  # a near miss warned
+        outcome("kerb", "near-miss", False, False, None),
+        outcome("kerb", "near-miss", True, True, 2.0),  # a near miss that met: a collision
+        outcome("look", "collision", False, True, None),  # neither: not counted
+    ]
+    j = ground_replay.Judged("x", 1.0, outs, np.zeros(1))
+    assert j.by_family() == {"cross": (1, 3), "kerb": (2, 3)}
