@@ -101,3 +101,16 @@ def test_family_medians_split_the_decisive_rows_by_what_lies_ahead() -> None:
     assert stop[6] == pytest.approx(0.75)  # the true speeds 0.8 and 0.7
     assert stop[7] == pytest.approx(-0.5)  # both slowing by 0.1 m/s over 0.2 s
     assert stop[8] == walk[8] == 1.5  # the track's speed: |(0, 1.5)|
+
+
+def test_by_family_on_a_dataset_whose_truth_has_no_speed_is_one_line(tmp_path: Path) -> None:
+    from tests.monopic.test_intent_tree import write_dataset
+
+    write_dataset(tmp_path / "d", {"kerb-a": 1})  # its truth lines carry no "speed"
+    r = subprocess.run(
+        [sys.executable, str(TOOL), str(tmp_path / "d"), "--by-family"],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert r.returncode == 2 and r.stdout == ""
+    (line,) = r.stderr.strip().splitlines()
+    assert line.startswith("intent_cue_auc: ") and "cannot read the truth's speed" in line
