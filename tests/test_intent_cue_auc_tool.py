@@ -114,3 +114,34 @@ def test_by_family_on_a_dataset_whose_truth_has_no_speed_is_one_line(tmp_path: P
     assert r.returncode == 2 and r.stdout == ""
     (line,) = r.stderr.strip().splitlines()
     assert line.startswith("intent_cue_auc: ") and "cannot read the truth's speed" in line
+
+
+def test_the_plot_draws_one_run_per_family_preferring_one_with_a_stop_ahead(
+    tmp_path: Path,
+) -> None:
+    from monopic.cases import Case
+    from monopic.replay.intent_training import LabelledRow, RunRows
+    from monopic.tree.intent import IntentSample
+    from monopic.variants.zone import RobotGeometry
+
+    robot = RobotGeometry(width=0.6, length=0.8, front=0.4)
+
+    def row(t: float, intent: str) -> LabelledRow:
+        s = IntentSample({"speed": 1.0}, Case.STILL, intent, (5.0, -2.0), (0.0, 1.5), (5.0, -2.0))
+        return LabelledRow(s, False, robot, 1.0, 0.0, time=t)
+
+    walk = RunRows("kerb/0", "kerb", 0, (row(1.0, "keep going"),), 1.0)
+    stop = RunRows("kerb/1", "kerb", 1, (row(1.0, "keep going"), row(1.1, "stop")), 1.0)
+    cross = RunRows("cross/0", "cross", 0, (row(2.0, "keep going"),), 1.0)
+    png = tmp_path / "p.png"
+    drawn = intent_cue_auc.plot_runs([walk, stop, cross], {"kerb/1": {1.0: 0.9}}, png)
+    assert drawn == ["cross/0", "kerb/1"] and png.read_bytes()[:4] == b"\x89PNG"
+
+
+def test_plot_without_by_family_is_one_line(tmp_path: Path) -> None:
+    r = subprocess.run(
+        [sys.executable, str(TOOL), str(tmp_path), "--plot", str(tmp_path / "p.png")],
+        capture_output=True, text=True, timeout=120,
+    )  # fmt: skip
+    assert r.returncode == 2 and r.stdout == ""
+    assert r.stderr.strip() == "intent_cue_auc: --plot draws the --by-family view; give both"

@@ -126,6 +126,50 @@ def family_medians(
     return out
 
 
+def plot_runs(
+    runs: list[RunRows], truth: Mapping[str, Mapping[float, float]], path: Path
+) -> list[str]:
+    """One panel per family: its first run with a decisive row (preferring one where a
+    stop or turn away lies ahead), the truth's speed beside the window's and the Kalman
+    track's over time, the decisive frames marked. Returns the runs drawn."""
+    from matplotlib.figure import Figure
+
+    from monopic.output import atomic_path
+
+    rows_of = decisive(runs)
+    chosen: dict[str, RunRows] = {}
+    for prefer_hold in (True, False):
+        for run, row in rows_of:
+            if (row.sample.intent in HOLDS) == prefer_hold:
+                chosen.setdefault(run.family, run)
+    families = sorted(chosen)
+    if not families:
+        raise UserError(f"{path}: nothing to draw: no decisive rows in these datasets")
+    decisive_times = {(run.run, row.time) for run, row in rows_of}
+    cols = 2 if len(families) > 1 else 1
+    fig = Figure(figsize=(6 * cols, 3.2 * math.ceil(len(families) / cols)), layout="constrained")
+    for i, family in enumerate(families):
+        run = chosen[family]
+        ax = fig.add_subplot(math.ceil(len(families) / cols), cols, i + 1)
+        t = [row.time for row in run.rows]
+        true = [truth.get(run.run, {}).get(round(x, 3), math.nan) for x in t]
+        ax.plot(t, true, color="black", label="true speed")
+        ax.plot(t, [r.sample.values.get("speed", math.nan) for r in run.rows], label="1 s window")
+        ax.plot(t, [math.hypot(*r.sample.velocity) for r in run.rows], label="Kalman track")
+        marks = [x for x in t if (run.run, x) in decisive_times]
+        ax.plot(marks, [0.05] * len(marks), "|", color="red", markersize=12, label="decisive")
+        ax.set_title(f"{family}: {run.run.split('/')[-1]}", fontsize=9)
+        ax.set_xlabel("time into the run (s)")
+        ax.set_ylabel("speed (m/s)")
+        ax.set_ylim(0, 2.5)
+        ax.grid(True, alpha=0.3)
+        if i == 0:
+            ax.legend(fontsize=7, loc="upper left")
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=100, format="png")
+    return [chosen[f].run for f in families]
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("datasets", nargs="+", type=Path, help="dataset folders (monopic dataset)")
@@ -135,7 +179,15 @@ def main() -> int:
         action="store_true",
         help="instead: per family, medians of time, speed and acceleration on decisive rows",
     )
+    ap.add_argument(
+        "--plot",
+        type=Path,
+        help="with --by-family: also draw one run per family (truth, window, track speed)",
+    )
     args = ap.parse_args()
+    if args.plot and not args.by_family:
+        print("intent_cue_auc: --plot draws the --by-family view; give both", file=sys.stderr)
+        return 2
     runs = []
     truth: dict[str, dict[float, float]] = {}
     for folder in args.datasets:
@@ -162,6 +214,13 @@ def main() -> int:
                 f"| {family} | {'yes' if hold else 'no'} | {n} | {t:.2f} s | {speed:.2f} m/s"
                 f" | {acc:+.2f} m/s² | {true:.2f} m/s | {true_acc:+.2f} m/s² | {track:.2f} m/s |"
             )
+        if args.plot:
+            try:
+                drawn = plot_runs(runs, truth, args.plot)
+            except UserError as err:
+                print(f"intent_cue_auc: {err}", file=sys.stderr)
+                return 2
+            print(f"\n{args.plot}: runs {', '.join(drawn)}")
         return 0
     rows = decisive_rows(runs) if args.decisive else [r.sample for run in runs for r in run.rows]
     which = "decisive rows" if args.decisive else "rows"
