@@ -39,7 +39,7 @@ from monopic.features.motion import VelocityEstimator
 from monopic.frame import EgoState
 from monopic.output import atomic_path
 from sim.analysis.ground_replay import Estimator, ground_errors, judge_warnings, replay
-from sim.analysis.metrics import LEAD_GOAL, FrameCounts, summarise
+from sim.analysis.metrics import FrameCounts, group_by, summarise
 from sim.runs.result import MAIN, RunResult
 from sim.runs.results_file import read_results
 
@@ -110,16 +110,12 @@ class Judged:
         runs warned at all. A near miss the track's lag causes shows in some families
         and not others (docs/intent/ground-tree.md, session 12)."""
         out: dict[str, tuple[int, int]] = {}
-        for o in self.outcomes:
-            if o.near_miss:
-                hit = bool(o.warned)
-            elif o.collision_run:
-                hit = o.lead is not None and o.lead >= LEAD_GOAL
-            else:
-                continue
-            warned, runs = out.get(o.family, (0, 0))
-            out[o.family] = (warned + hit, runs + 1)
-        return dict(sorted(out.items()))
+        for family, outs in group_by(self.outcomes, lambda o: o.family).items():
+            sm = summarise(METHOD, outs)
+            runs = sm.collision_runs + sm.near_miss_runs
+            if runs:
+                out[family] = (sm.warned_1s + sm.near_miss_warned, runs)
+        return out
 
     def row(self) -> str:
         sm = summarise(METHOD, self.outcomes)
