@@ -11,6 +11,10 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from monopic.cases import Case
+from monopic.replay.intent_training import LabelledRow, RunRows
+from monopic.tree.intent import IntentSample
+from monopic.variants.zone import RobotGeometry
 from tests.paths import ROOT
 
 TOOL = ROOT / "tools" / "intent_cue_auc.py"
@@ -18,6 +22,19 @@ _spec = importlib.util.spec_from_file_location("intent_cue_auc", TOOL)
 assert _spec is not None and _spec.loader is not None
 intent_cue_auc = importlib.util.module_from_spec(_spec)
 _spec.loader.exec_module(intent_cue_auc)
+
+
+def labelled(
+    t: float,
+    intent: str,
+    position: tuple[float, float],
+    velocity: tuple[float, float],
+    values: dict[str, float] | None = None,
+) -> LabelledRow:
+    """A training row of a small robot (0.6 m wide) standing still, the future unused."""
+    robot = RobotGeometry(width=0.6, length=0.8, front=0.4)
+    s = IntentSample(values or {}, Case.STILL, intent, position, velocity, position)
+    return LabelledRow(s, False, robot, 1.0, 0.0, time=t)
 
 
 def test_auc_of_separated_reversed_tied_and_empty_groups() -> None:
@@ -55,16 +72,8 @@ def test_the_cue_gate_tool_names_a_missing_tree_in_one_line(tmp_path: Path) -> N
 
 
 def test_decisive_rows_are_those_where_constant_velocity_reaches_the_band_from_outside() -> None:
-    from monopic.cases import Case
-    from monopic.replay.intent_training import LabelledRow, RunRows
-    from monopic.tree.intent import IntentSample
-    from monopic.variants.zone import RobotGeometry
-
-    robot = RobotGeometry(width=0.6, length=0.8, front=0.4)
-
     def row(y: float, vl: float) -> LabelledRow:
-        s = IntentSample({}, Case.STILL, "stop", (5.0, y), (0.0, vl), (5.0, y))
-        return LabelledRow(s, False, robot, 1.0, 0.0)
+        return labelled(math.nan, "stop", (5.0, y), (0.0, vl))
 
     rows = (row(-2.0, 1.5), row(-2.0, 0.2), row(0.1, 0.0), row(2.0, -1.3), row(-2.0, float("nan")))
     run = RunRows("r", "f", 0, rows, horizon=1.0)
@@ -73,17 +82,8 @@ def test_decisive_rows_are_those_where_constant_velocity_reaches_the_band_from_o
 
 
 def test_family_medians_split_the_decisive_rows_by_what_lies_ahead() -> None:
-    from monopic.cases import Case
-    from monopic.replay.intent_training import LabelledRow, RunRows
-    from monopic.tree.intent import IntentSample
-    from monopic.variants.zone import RobotGeometry
-
-    robot = RobotGeometry(width=0.6, length=0.8, front=0.4)
-
     def row(t: float, intent: str, speed: float, acc: float, y: float = -2.0) -> LabelledRow:
-        values = {"speed": speed, "acceleration": acc}
-        s = IntentSample(values, Case.STILL, intent, (5.0, y), (0.0, 1.5), (5.0, y))
-        return LabelledRow(s, False, robot, 1.0, 0.0, time=t)
+        return labelled(t, intent, (5.0, y), (0.0, 1.5), {"speed": speed, "acceleration": acc})
 
     stops = RunRows(
         "a", "kerb", 0, (row(2.0, "stop", 0.9, 1.2), row(2.2, "turn away", 1.1, 0.8)), 1.0
@@ -119,16 +119,8 @@ def test_by_family_on_a_dataset_whose_truth_has_no_speed_is_one_line(tmp_path: P
 def test_the_plot_draws_one_run_per_family_preferring_one_with_a_stop_ahead(
     tmp_path: Path,
 ) -> None:
-    from monopic.cases import Case
-    from monopic.replay.intent_training import LabelledRow, RunRows
-    from monopic.tree.intent import IntentSample
-    from monopic.variants.zone import RobotGeometry
-
-    robot = RobotGeometry(width=0.6, length=0.8, front=0.4)
-
     def row(t: float, intent: str) -> LabelledRow:
-        s = IntentSample({"speed": 1.0}, Case.STILL, intent, (5.0, -2.0), (0.0, 1.5), (5.0, -2.0))
-        return LabelledRow(s, False, robot, 1.0, 0.0, time=t)
+        return labelled(t, intent, (5.0, -2.0), (0.0, 1.5), {"speed": 1.0})
 
     walk = RunRows("kerb/0", "kerb", 0, (row(1.0, "keep going"),), 1.0)
     stop = RunRows("kerb/1", "kerb", 1, (row(1.0, "keep going"), row(1.1, "stop")), 1.0)
