@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 
-from monopic.features.extractor import FeatureExtractor
+from monopic.features.extractor import FeatureExtractor, GroundColumn
 from monopic.features.record import Features
 from monopic.frame import Frame
 from monopic.pose.region import Region
@@ -37,6 +37,7 @@ class PipelineConfig:
     mode: Mode = Mode.IMAGE
     tracker: TrackerConfig = field(default_factory=TrackerConfig)
     warning: CollisionWarning = field(default_factory=CollisionWarning)
+    ground_column: GroundColumn = GroundColumn.HIPS  # the ground point's image column
 
     def __post_init__(self) -> None:
         if not self.horizon > 0:
@@ -119,7 +120,9 @@ class Pipeline:
         if len(set(keys)) != len(keys):
             raise ValueError(f"predictors must differ by name or mode, got {keys}")
         self.tracker = PoseTracker(self.config.tracker)
-        self.features = FeatureExtractor(robot_width=self.config.warning.robot.width)
+        self.features = FeatureExtractor(
+            robot_width=self.config.warning.robot.width, ground_column=self.config.ground_column
+        )
 
     @property
     def primary(self) -> str:

@@ -14,6 +14,7 @@ from tqdm import tqdm
 from monopic.camera import CameraModel
 from monopic.cli.args import non_negative_float, output_file, positive_float, positive_int
 from monopic.errors import UserError
+from monopic.features.extractor import GroundColumn
 from monopic.frame import EgoState
 from monopic.framelog import FRAME_COLUMNS, authors_finite, frame_row
 from monopic.output import atomic_path
@@ -97,6 +98,14 @@ def register(sub: argparse._SubParsersAction) -> None:
         "kernels) or openvino (Intel's, float32; the optional extra .[openvino]); "
         "default %(default)s",
     )
+    p.add_argument(
+        "--ground-column",
+        choices=[c.value for c in GroundColumn],
+        default=PipelineConfig.ground_column.value,
+        help="which landmarks set the ground point's image column (its row is the feet's): "
+        "the hips' midpoint, steady through the stride; the shoulders'; or the visible "
+        "feet's mean (up to session 12) (default %(default)s)",
+    )
     g = p.add_argument_group("camera geometry (needed for ground mode and the projected zone)")
     g.add_argument("--fov", type=positive_float, help="vertical field of view, degrees")
     g.add_argument("--camera-height", type=positive_float, help="metres above the ground")
@@ -142,6 +151,7 @@ def run(args: argparse.Namespace) -> int:
             horizon=args.horizon,
             mode=mode,
             tracker=TrackerConfig(threads=args.threads, model=args.model, runtime=args.runtime),
+            ground_column=GroundColumn(args.ground_column),
         ),
         predictor,
     )

@@ -6,14 +6,20 @@ import numpy as np
 import pytest
 
 from monopic.camera import CameraModel
-from monopic.features.extractor import FeatureExtractor, foot_point
+from monopic.features.extractor import FeatureExtractor, GroundColumn, foot_point
 from monopic.features.ground import GroundMotion
 from monopic.features.motion import VelocityEstimator
 from monopic.features.smoothing import Kalman1D, MovingAverage
 from monopic.frame import EgoState
 from monopic.pose.landmarks import Pose
 from monopic.pose.region import Region
-from monopic.pose.skeleton import FOOT_LANDMARKS, LEFT_SHOULDER, RIGHT_SHOULDER
+from monopic.pose.skeleton import (
+    FOOT_LANDMARKS,
+    LEFT_HIP,
+    LEFT_SHOULDER,
+    RIGHT_HIP,
+    RIGHT_SHOULDER,
+)
 
 CAM = CameraModel.from_fov(768, 432, 70, 1.0, pitch_deg=5)
 
@@ -97,6 +103,22 @@ def test_foot_point_from_feet_or_box_bottom():
     assert foot_point(p, 432)[1] == pytest.approx(300.0)
     q = _pose(feet_visible=False)
     assert foot_point(q, 432) == pytest.approx((400.0, 300.0))
+
+
+def test_ground_column_from_hips_or_shoulders_row_from_the_feet():
+    p = _pose()
+    # A stride: one foot 30 px ahead, the other hidden; the hips and shoulders stay put.
+    feet = list(FOOT_LANDMARKS)
+    p.landmarks[feet[: len(feet) // 2], 0] = 430.0
+    p.visibility[feet[len(feet) // 2 :]] = 0.1
+    p.landmarks[[LEFT_HIP, RIGHT_HIP], 0] = (412.0, 392.0)  # midpoint 402
+    row = p.landmarks[feet[: len(feet) // 2], 1].max()  # the lowest visible foot point
+    assert foot_point(p, 432) == pytest.approx((430.0, row))
+    assert foot_point(p, 432, GroundColumn.HIPS) == pytest.approx((402.0, row))
+    assert foot_point(p, 432, GroundColumn.SHOULDERS)[0] == pytest.approx(400.0)
+    # A hidden hip: back to the feet's column.
+    p.visibility[LEFT_HIP] = 0.2
+    assert foot_point(p, 432, GroundColumn.HIPS)[0] == pytest.approx(430.0)
 
 
 def test_extractor_velocity_and_gap_reset():
