@@ -10,7 +10,7 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 from enum import StrEnum
 
-from monopic.features.extractor import FeatureExtractor, GroundColumn
+from monopic.features.extractor import DEFAULT_GROUND_COLUMN, FeatureExtractor, GroundColumn
 from monopic.features.record import Features
 from monopic.frame import Frame
 from monopic.pose.region import Region
@@ -37,7 +37,7 @@ class PipelineConfig:
     mode: Mode = Mode.IMAGE
     tracker: TrackerConfig = field(default_factory=TrackerConfig)
     warning: CollisionWarning = field(default_factory=CollisionWarning)
-    ground_column: GroundColumn = GroundColumn.HIPS  # the ground point's image column
+    ground_column: GroundColumn = DEFAULT_GROUND_COLUMN  # the ground point's image column
 
     def __post_init__(self) -> None:
         if not self.horizon > 0:

@@ -26,7 +26,7 @@ from monopic.pose.skeleton import (
     RIGHT_SHOULDER,
 )
 
-# Foot landmarks below this visibility are not trusted for the foot point.
+# Landmarks (feet, hips, shoulders) below this visibility are not trusted for the ground point.
 MIN_FOOT_VISIBILITY = 0.5
 # The default robot's width, m: monopic.variants.zone.RobotGeometry's (the pipeline passes
 # its own robot's; features cannot import the variants above them).
@@ -48,6 +48,9 @@ class GroundColumn(StrEnum):
     HIPS = "hips"
     SHOULDERS = "shoulders"
 
+
+# The column the pipeline uses unless told otherwise (FeatureExtractor, PipelineConfig).
+DEFAULT_GROUND_COLUMN = GroundColumn.HIPS
 
 _COLUMN_PAIRS = {
     GroundColumn.HIPS: (LEFT_HIP, RIGHT_HIP),
@@ -91,7 +94,7 @@ class FeatureExtractor:
     kinematics: KinematicsConfig = field(default_factory=KinematicsConfig)
     phi_rate_window: float = 0.5  # s: a shoulder turn leading a walking turn takes ~0.5 s
     robot_width: float = DEFAULT_ROBOT_WIDTH  # m, the swept path's width
-    ground_column: GroundColumn = GroundColumn.HIPS  # the ground point's image column
+    ground_column: GroundColumn = DEFAULT_GROUND_COLUMN  # the ground point's image column
     min_head_visibility: float = MIN_HEAD_VISIBILITY
     _image_velocity: VelocityEstimator = field(init=False)
     _ground: GroundMotion = field(init=False)
