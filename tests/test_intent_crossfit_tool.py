@@ -1,0 +1,145 @@
+"""tools/intent_crossfit.py: folds keep families whole, the truth's reading is the walker's own
+motion, the hold-back acts on the out-of-fold share only, and bad input is one line."""
+
+from __future__ import annotations
+
+import importlib.util
+import math
+import subprocess
+import sys
+from pathlib import Path
+from types import SimpleNamespace
+
+import pytest
+
+from monopic.camera import CameraModel
+from monopic.features.record import Features, GroundFeatures
+from monopic.predict.base import Mode
+from monopic.predict.registry import make_predictor
+from sim.analysis.ground_replay import ReplayFrame
+from tests.paths import ROOT
+
+TOOL = ROOT / "tools" / "intent_crossfit.py"
+_spec = importlib.util.spec_from_file_location("intent_crossfit", TOOL)
+assert _spec is not None and _spec.loader is not None
+crossfit = importlib.util.module_from_spec(_spec)
+sys.modules["intent_crossfit"] = crossfit  # dataclasses look their module up there
+_spec.loader.exec_module(crossfit)
+
+CAMERA = CameraModel.from_fov(768, 432, vertical_fov_deg=65.0, mount_height=1.2, pitch_deg=5.0)
+DT = 1 / 15
+
+
+def walker(lateral_speeds: list[float], robot_speed: float = 1.0, start_left: float = -3.0):
+    """A walker 6 m ahead stepping left (toward the path) at the given speeds, one per
+    frame, while the robot drives straight at `robot_speed`: its truth columns."""
+    t, fwd, lat = [0.0], [6.0], [start_left]
+    for v in lateral_speeds:
+        t.append(t[-1] + DT)
+        fwd.append(fwd[-1] - robot_speed * DT)
+        lat.append(lat[-1] + v * DT)
+    n = len(t)
+    truth = SimpleNamespace(
+        t=t, forward=fwd, lateral=lat, robot_speed=[robot_speed] * n, phi=[90.0] * n,
+        head_yaw=[10.0] * n,
+    )  # fmt: skip
+    return SimpleNamespace(truth=truth, scenario=SimpleNamespace(robot_width=0.6, horizon=1.0))
+
+
+def test_the_truths_reading_is_the_walkers_own_motion_without_the_robots() -> None:
+    row = walker([1.2] * 10)
+    v = crossfit.truth_values(row, 10)
+    assert v["forward"] == pytest.approx(0.0, abs=1e-9)  # the robot's travel taken out
+    assert v["left"] == pytest.approx(1.2) and v["speed"] == pytest.approx(1.2)
+    assert v["acceleration"] == pytest.approx(0.0, abs=1e-9)
+    assert v["heading_rate"] == pytest.approx(0.0, abs=1e-9)
+    assert v["path_offset"] == pytest.approx(-3.0 + 1.2 * 10 * DT)
+    assert v["path_distance"] == pytest.approx(3.0 - 1.2 * 10 * DT - 0.3)
+    assert v["phi"] == 90.0 and v["phi_rate"] == pytest.approx(0.0) and v["head_yaw"] == 10.0
+
+
+def test_a_slowing_walker_reads_a_negative_acceleration_and_a_late_reading_misses_it() -> None:
+    speeds = [1.2] * 10 + [1.2 - 0.15 * i for i in range(1, 6)]  # -2.25 m/s^2 at the end
+    row = walker(speeds)
+    now = crossfit.truth_values(row, 15)
+    assert now["acceleration"] == pytest.approx(-0.15 / DT, rel=1e-6)
+    assert now["speed"] == pytest.approx(1.2 - 0.75)
+    late = crossfit.truth_values(row, crossfit.delayed(row, 15, 0.4))
+    assert crossfit.delayed(row, 15, 0.4) == 9  # 6 frames of 1/15 s
+    assert late["acceleration"] == pytest.approx(0.0, abs=1e-9)
+    assert crossfit.delayed(row, 15, 0.0) == 15
+
+
+def test_no_frame_before_means_no_motion() -> None:
+    v = crossfit.truth_values(walker([1.0] * 3), 0)
+    assert all(math.isnan(x) for x in v.values() if x is not None)
+
+
+def test_every_family_lands_in_every_fold_and_the_deal_is_stable() -> None:
+    rows = [SimpleNamespace(id=f"{fam}-{i}", family=fam) for fam in "abc" for i in range(7)]
+    folds = crossfit.deal_folds(rows, 3)
+    for fam in "abc":
+        got = [f for r, f in zip(rows, folds, strict=True) if r.family == fam]
+        assert sorted(set(got)) == [0, 1, 2] and max(got.count(k) for k in range(3)) == 3
+    assert crossfit.deal_folds(list(reversed(rows)), 3) == list(reversed(folds))
+
+
+def frame(k: int) -> ReplayFrame:
+    ground = GroundFeatures((6.0, -3.0), (0.0, 1.4), CAMERA, path_offset=-3.0, path_distance=2.7)
+    f = Features(0.0, (400.0, 200.0), (400.0, 300.0), 100.0, 0.0, 0.0, 0.0, ground)
+    return ReplayFrame(k, f, make_predictor("constant-velocity", Mode.GROUND).predict(f, 1.0))
+
+
+def test_the_hold_back_acts_only_where_the_out_of_fold_share_reaches_the_threshold() -> None:
+    row = SimpleNamespace(scenario=SimpleNamespace(horizon=1.0))
+    shares = {(0, 0): (0.4, "stop"), (0, 1): (0.1, "stop"), (0, 2): (0.5, "turn away")}
+    rule = crossfit.hold_rule(row, 0, shares, 0.3)
+    held = rule(frame(0))
+    assert held is not None and held.ground == pytest.approx((6.0, -3.0))  # where it stands
+    assert rule(frame(1)) is None  # below the threshold: constant velocity's point
+    turned = rule(frame(2))
+    assert turned is not None and turned.ground == pytest.approx((6.0, -3.0))  # no step in
+    assert rule(frame(3)) is None  # a frame without a share (no ground point) is not held
+
+
+def test_a_reading_names_its_source_its_delay_and_what_it_leaves_out() -> None:
+    motion = crossfit.Reading.parse("truth-motion@0.2")
+    assert motion.truth and motion.delay == pytest.approx(0.2)
+    assert set(motion.without) == {"phi", "phi_rate", "head_yaw"}
+    assert crossfit.Reading.parse("pipeline") == crossfit.Reading("pipeline", False, 0.0, ())
+
+
+def test_a_later_file_replaces_an_earlier_files_runs_of_the_same_family(monkeypatch) -> None:
+    def run(id: str, family: str, labelled: bool = True) -> SimpleNamespace:
+        return SimpleNamespace(id=id, family=family, truth=SimpleNamespace(intent=[
+            "stop" if labelled else None]))  # fmt: skip
+
+    files = {
+        "judged.jsonl": [run("a1", "cross"), run("b1", "stop"), run("b2", "stop")],
+        "redraw.jsonl": [run("b3", "stop"), run("c1", "look", labelled=False)],
+    }
+    monkeypatch.setattr(crossfit, "read_results", lambda path: files[path.name])
+    got = crossfit.combined([Path("judged.jsonl"), Path("redraw.jsonl")])
+    assert [r.id for r in got] == ["a1", "b3"]  # the redraw's stops; unlabelled runs dropped
+
+
+def run_tool(*args: str) -> subprocess.CompletedProcess[str]:
+    return subprocess.run(
+        [sys.executable, str(TOOL), *args], capture_output=True, text=True, cwd=ROOT
+    )
+
+
+def test_bad_input_is_one_line(tmp_path: Path) -> None:
+    missing = run_tool(str(tmp_path / "none.jsonl"))
+    assert missing.returncode == 1 and "no such results file" in missing.stderr
+    assert len(missing.stderr.strip().splitlines()) == 1
+    empty = tmp_path / "empty.jsonl"
+    empty.write_text("")
+    late = run_tool(str(empty), "--reading", "pipeline@0.2")
+    assert late.returncode == 1 and "only the truth's reading can be made late" in late.stderr
+    for bad in ("eyes", "truth@soon", "truth@-1"):
+        got = run_tool(str(empty), "--reading", bad)
+        assert got.returncode == 1 and got.stderr.startswith("--reading: ")
+        assert len(got.stderr.strip().splitlines()) == 1
+    unknown = run_tool(str(empty), "--without", "nose")
+    assert unknown.returncode == 1 and "no attribute 'nose'" in unknown.stderr
