@@ -36,7 +36,7 @@ import hashlib
 import math
 import sys
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -53,7 +53,7 @@ from monopic.tree.discretise import CutPointBins, Discretiser
 from monopic.tree.id3 import DecisionTree, ID3Params, fit_id3
 from monopic.tree.intent import INTENT_ATTRIBUTES, IntentRules, LeafReading, place
 from sim.analysis.ground_replay import PointRule, ReplayFrame, judge_warnings, replay
-from sim.analysis.metrics import LEAD_GOAL, RunOutcome, paired_recall
+from sim.analysis.metrics import LEAD_GOAL, PairedRecall, RunOutcome, paired_recall
 from sim.runs.result import MAIN, RunResult
 from sim.runs.results_file import read_results
 
@@ -106,20 +106,21 @@ def collect_run(i: int, row: RunResult, truth: bool = False, delay: float = 0.0)
         p = phi[f.k] if f.k < len(phi) else None
         if p is not None and math.isfinite(p):
             history.add(f.features.timestamp, p)
-        kin = motion.kinematics()
-        values = {
-            "forward": g.velocity[0],
-            "left": g.velocity[1],
-            "speed": kin.speed,
-            "acceleration": kin.acceleration,
-            "heading_rate": kin.heading_rate,
-            "phi": math.nan if p is None else p,
-            "phi_rate": angle_rate(history),
-            "path_offset": g.path_offset,
-            "path_distance": g.path_distance,
-        }
         if truth:
             values = truth_values(row, delayed(row, f.k, delay))
+        else:
+            kin = motion.kinematics()
+            values = {
+                "forward": g.velocity[0],
+                "left": g.velocity[1],
+                "speed": kin.speed,
+                "acceleration": kin.acceleration,
+                "heading_rate": kin.heading_rate,
+                "phi": math.nan if p is None else p,
+                "phi_rate": angle_rate(history),
+                "path_offset": g.path_offset,
+                "path_distance": g.path_distance,
+            }
         intent = labels[f.k] if f.k < len(labels) else None
         out.append(FrameRow(i, f.k, values, intent))
         return None
@@ -197,15 +198,19 @@ def grow(train: Sequence[FrameRow], depth: int, bins: int) -> tuple[Discretiser,
         ),
     )
     binned = [disc.discretise(r.values) for r in train]
-    labels = [r.intent or "unknown" for r in train]
+    labels = [r.intent for r in train]  # only labelled frames are trained on
     tree = fit_id3(binned, labels, attributes, params=ID3Params(min_samples=2, max_depth=depth))
     return disc, tree
 
 
 def hold_shares(
-    frames: Sequence[FrameRow], fold_of: Sequence[int], folds: int, depth: int, bins: int,
+    frames: Sequence[FrameRow],
+    fold_of: Sequence[int],
+    folds: int,
+    depth: int,
+    bins: int,
     min_rows: int,
-) -> dict[tuple[int, int], tuple[float, str]]:  # fmt: skip
+) -> dict[tuple[int, int], tuple[float, str]]:
     """Out-of-fold (stop + turn-away share, the commoner of the two) per (run, frame)."""
     shares: dict[tuple[int, int], tuple[float, str]] = {}
     for fold in range(folds):
@@ -246,16 +251,27 @@ def hold_rule(
     return point
 
 
-def judge(rows: Sequence[RunResult], rule_of, name: str) -> list[RunOutcome]:  # type: ignore[no-untyped-def]
+def judge(
+    rows: Sequence[RunResult], rule_of: Callable[[int, RunResult], PointRule | None], name: str
+) -> list[RunOutcome]:
+    """Every run replayed with its rule (None: constant velocity) and judged as `name`."""
     return [
         judge_warnings(row, replay(row, GroundMotion(), rule_of(i, row))[0], name)
         for i, row in enumerate(rows)
     ]
 
 
-def summary(outs: list[RunOutcome], base: list[RunOutcome], families: list[str]) -> dict:
-    """Near misses warned, recall difference overall and the worst family's lower bound."""
-    p = paired_recall(outs, base)
+@dataclass(frozen=True)
+class Trade:
+    """One threshold's outcome against constant velocity: all families together, and the
+    family whose paired recall difference has the lowest lower bound."""
+
+    all: PairedRecall
+    worst_low: float
+    worst_family: str
+
+
+def trade(outs: list[RunOutcome], base: list[RunOutcome], families: list[str]) -> Trade:
     worst = (math.inf, "")
     for fam in families:
         pf = paired_recall(
@@ -263,7 +279,7 @@ def summary(outs: list[RunOutcome], base: list[RunOutcome], families: list[str])
         )
         if pf.collision_runs and pf.low < worst[0]:
             worst = (pf.low, fam)
-    return {"all": p, "worst_low": worst[0], "worst_family": worst[1]}
+    return Trade(paired_recall(outs, base), worst[0], worst[1])
 
 
 @dataclass(frozen=True)
@@ -401,19 +417,19 @@ def main(argv: list[str] | None = None) -> int:
                 def rule(i: int, row: RunResult, th: float = th, sh: dict = shares) -> PointRule:
                     return hold_rule(row, i, sh, th)
 
-                s = summary(judge(rows, rule, "crossfit"), base, families)
-                p = s["all"]
+                s = trade(judge(rows, rule, "crossfit"), base, families)
+                p = s.all
                 table.append(
                     f"| {reading.name} | {depth} | {th:g} | "
                     f"{p.near_miss_warned[0]}/{p.near_miss_runs} | {p.near_miss_warned[1]} | "
                     f"{p.warned_1s[0]}/{p.collision_runs} | "
                     f"{100 * p.difference:+.0f} [{100 * p.low:+.0f}, {100 * p.high:+.0f}] | "
-                    f"{s['worst_family']}: {100 * s['worst_low']:+.0f} |"
+                    f"{s.worst_family}: {100 * s.worst_low:+.0f} |"
                 )
                 print(table[-1], file=sys.stderr, flush=True)
                 ratio = p.near_miss_warned[0] / max(p.near_miss_warned[1], 1)
                 curves.setdefault((reading.name, depth), []).append(
-                    (ratio, 100 * p.difference, 100 * s["worst_low"])
+                    (ratio, 100 * p.difference, 100 * s.worst_low)
                 )
     text = "\n".join([*lines, "", *table]) + "\n"
     print(text)
