@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 from types import SimpleNamespace
 
+import numpy as np
 import pytest
 
 from monopic.camera import CameraModel
@@ -107,6 +108,8 @@ def test_a_reading_names_its_source_its_delay_and_what_it_leaves_out() -> None:
     assert motion.truth and motion.delay == pytest.approx(0.2)
     assert set(motion.without) == {"phi", "phi_rate", "head_yaw"}
     assert crossfit.Reading.parse("pipeline") == crossfit.Reading("pipeline", False, 0.0, ())
+    recent = crossfit.Reading.parse("pipeline-recent")
+    assert recent.recent and not recent.truth and not recent.without
 
 
 def test_a_later_file_replaces_an_earlier_files_runs_of_the_same_family(monkeypatch) -> None:
@@ -121,6 +124,24 @@ def test_a_later_file_replaces_an_earlier_files_runs_of_the_same_family(monkeypa
     monkeypatch.setattr(crossfit, "read_results", lambda path: files[path.name])
     got = crossfit.combined([Path("judged.jsonl"), Path("redraw.jsonl")])
     assert [r.id for r in got] == ["a1", "b3"]  # the redraw's stops; unlabelled runs dropped
+
+
+def test_the_recent_velocity_is_the_measured_foot_points_own_over_the_last_window() -> None:
+    from monopic.features.ground import GroundMotion
+    from monopic.features.window import SlidingWindow
+
+    n = 10
+    row = SimpleNamespace(truth=SimpleNamespace(robot_speed=[0.0] * n))
+    motion, window = GroundMotion(), SlidingWindow(crossfit.RECENT_WINDOW)
+    got = []
+    for k in range(n):  # 6 m ahead, stepping left at 1.2 m/s; the robot standing
+        t = k * DT
+        foot = CAMERA.project(np.array([6.0, -3.0 + 1.2 * t, 0.0]))
+        f = Features(t, tuple(foot), tuple(foot), 100.0, 0.0, 0.0, 0.0, None)
+        got.append(crossfit.recent_velocity(row, ReplayFrame(k, f, None), CAMERA, motion, window))
+    assert math.isnan(got[2]["left_recent"])  # three points: not yet
+    assert got[-1]["left_recent"] == pytest.approx(1.2, abs=1e-6)
+    assert got[-1]["forward_recent"] == pytest.approx(0.0, abs=1e-6)
 
 
 def run_tool(*args: str) -> subprocess.CompletedProcess[str]:

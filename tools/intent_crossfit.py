@@ -40,19 +40,22 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 from matplotlib.figure import Figure
 
+from monopic.camera import CameraModel
 from monopic.errors import UserError
-from monopic.features.ground import GroundMotion
+from monopic.features.ground import GroundMotion, foot_on_ground
 from monopic.features.swept_path import path_offset
 from monopic.features.window import SlidingWindow, angle_rate
+from monopic.frame import EgoState
 from monopic.output import atomic_path
 from monopic.predict.base import Prediction, with_ground_point
 from monopic.replay.intent_training import quantile_cuts
 from monopic.tree.discretise import CutPointBins, Discretiser
 from monopic.tree.id3 import DecisionTree, ID3Params, fit_id3
 from monopic.tree.intent import INTENT_ATTRIBUTES, IntentRules, LeafReading, place
-from sim.analysis.ground_replay import PointRule, ReplayFrame, judge_warnings, replay
+from sim.analysis.ground_replay import PointRule, ReplayFrame, camera, judge_warnings, replay
 from sim.analysis.metrics import LEAD_GOAL, PairedRecall, RunOutcome, paired_recall
 from sim.runs.result import MAIN, RunResult
 from sim.runs.results_file import read_results
@@ -63,6 +66,7 @@ ATTRIBUTES = tuple(a for a in INTENT_ATTRIBUTES if a not in ("head_yaw", "head_t
 # reading of it is not in the results file, and reads a fifth of a turn: session 9).
 TRUTH_ATTRIBUTES = (*ATTRIBUTES, "head_yaw")
 TRUTH_WINDOW = 0.2  # s: the truth's acceleration, heading and facing rates
+RECENT_WINDOW = 0.4  # s: the `pipeline-recent` reading's line fit (about 0.2 s of lag)
 PHI_RATE_WINDOW = 0.5  # s, as the feature extractor's phi rate (FeatureExtractor)
 THRESHOLDS = (0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8)
 BASELINE = "constant velocity (replayed)"
@@ -92,10 +96,19 @@ def deal_folds(rows: Sequence[RunResult], folds: int) -> list[int]:
     return [order[r.id] % folds for r in rows]
 
 
-def collect_run(i: int, row: RunResult, truth: bool = False, delay: float = 0.0) -> list[FrameRow]:
-    """One run's frames with a ground point: the features the tree reads, rebuilt by replay."""
+def collect_run(
+    i: int, row: RunResult, truth: bool = False, delay: float = 0.0, recent: bool = False
+) -> list[FrameRow]:
+    """One run's frames with a ground point: the features the tree reads, rebuilt by replay.
+
+    `recent` adds the foot point's own velocity over the last RECENT_WINDOW seconds (a line
+    through the measured ground points in the odometry frame, read at the newest): a
+    shorter-lag, noisier reading than the track's.
+    """
     out: list[FrameRow] = []
     motion = GroundMotion()
+    cam = camera(row)
+    measured = SlidingWindow(RECENT_WINDOW)
     phi = row.pipelines[MAIN].phi
     history = SlidingWindow(PHI_RATE_WINDOW)
     labels = row.truth.intent
@@ -121,12 +134,32 @@ def collect_run(i: int, row: RunResult, truth: bool = False, delay: float = 0.0)
                 "path_offset": g.path_offset,
                 "path_distance": g.path_distance,
             }
+            if recent:
+                values.update(recent_velocity(row, f, cam, motion, measured))
         intent = labels[f.k] if f.k < len(labels) else None
         out.append(FrameRow(i, f.k, values, intent))
         return None
 
     replay(row, motion, record)
     return out
+
+
+def recent_velocity(
+    row: RunResult, f: ReplayFrame, cam: CameraModel, motion: GroundMotion, window: SlidingWindow
+) -> dict[str, float]:
+    """The measured foot point's velocity (robot axes) over the last window: a line fit."""
+    speed = row.truth.robot_speed[f.k]
+    got = foot_on_ground(EgoState(cam, speed or 0.0, 0.0), f.features.foot, 1.0, 0.0)
+    if got is not None:
+        g = got[0]
+        window.add(f.features.timestamp, np.array(motion.odometry.to_fixed((g[0], g[1]))))
+    nan = {"forward_recent": math.nan, "left_recent": math.nan}
+    if len(window) < 4 or window.span < 0.5 * RECENT_WINDOW:
+        return nan
+    t, xy, _ = window.arrays()
+    vx, vy = (float(np.polyfit(t - t[-1], xy[:, d], 1)[0]) for d in (0, 1))
+    vf, vl = motion.odometry.rotate_to_robot((vx, vy))
+    return {"forward_recent": vf, "left_recent": vl}
 
 
 def delayed(row: RunResult, k: int, delay: float) -> int:
@@ -290,6 +323,7 @@ class Reading:
     truth: bool
     delay: float
     without: tuple[str, ...]
+    recent: bool = False  # add the measured foot point's velocity over RECENT_WINDOW
 
     @classmethod
     def parse(cls, text: str) -> Reading:
@@ -302,14 +336,15 @@ class Reading:
             raise UserError(f"--reading: {text!r}: the delay after @ is not seconds") from None
         if not (math.isfinite(delay) and delay >= 0):
             raise UserError(f"--reading: {text!r}: the delay must be seconds >= 0")
-        if delay and name == "pipeline":
+        if delay and name.startswith("pipeline"):
             raise UserError(f"--reading: {text!r}: only the truth's reading can be made late")
-        return cls(text, name != "pipeline", delay, READINGS[name])
+        return cls(text, name.startswith("truth"), delay, READINGS[name], name == "pipeline-recent")
 
 
 # Each reading's attributes beyond those the tool leaves out for all (--without).
 READINGS: dict[str, tuple[str, ...]] = {
     "pipeline": (),
+    "pipeline-recent": (),  # plus the foot point's velocity over the last RECENT_WINDOW
     "truth": (),
     "truth-motion": ("phi", "phi_rate", "head_yaw"),  # the walker's motion alone
 }
@@ -400,7 +435,7 @@ def main(argv: list[str] | None = None) -> int:
         frames = [
             fr
             for i, row in enumerate(rows)
-            for fr in collect_run(i, row, reading.truth, reading.delay)
+            for fr in collect_run(i, row, reading.truth, reading.delay, reading.recent)
         ]
         for fr in frames:
             for a in (*args.without, *reading.without):
