@@ -70,7 +70,10 @@ ATTRIBUTES = tuple(a for a in INTENT_ATTRIBUTES if a not in ("head_yaw", "head_t
 # The truth's reading adds the head's true yaw from the shoulders (the pipeline's own
 # reading of it is not in the results file, and reads a fifth of a turn: session 9).
 TRUTH_ATTRIBUTES = (*ATTRIBUTES, "head_yaw")
-TRUTH_WINDOW = 0.2  # s: the truth's acceleration, heading and facing rates
+# s: the truth's acceleration, heading and facing rates, from the first frame at least this
+# far back by a plain float comparison (3 or 4 frames at 15 fps: 0.2-0.27 s; `delayed`
+# allows 1e-9 and would take 3 always, which moves the truth readings' tables)
+TRUTH_WINDOW = 0.2
 RECENT_WINDOW = 0.4  # s: the `pipeline-recent` reading's line fit (about 0.2 s of lag)
 PHI_RATE_WINDOW = 0.5  # s, as the feature extractor's phi rate (FeatureExtractor)
 THRESHOLDS = (0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8)
@@ -102,14 +105,16 @@ def deal_folds(rows: Sequence[RunResult], folds: int) -> list[int]:
 
 
 def collect_run(
-    i: int, row: RunResult, truth: bool = False, delay: float = 0.0, recent: bool = False
+    i: int, row: RunResult, reading: Reading, drop: Sequence[str] = ()
 ) -> list[FrameRow]:
-    """One run's frames with a ground point: the features the tree reads, rebuilt by replay.
+    """One run's frames with a ground point: the attributes the reading gives, rebuilt by
+    replay, less the reading's own leave-outs and `drop`.
 
-    `recent` adds the foot point's own velocity over the last RECENT_WINDOW seconds (a line
-    through the measured ground points in the odometry frame, read at the newest): a
-    shorter-lag, noisier reading than the track's.
+    A `recent` reading adds the foot point's own velocity over the last RECENT_WINDOW
+    seconds (a line through the measured ground points in the odometry frame, read at the
+    newest): a shorter-lag, noisier reading than the track's.
     """
+    leave_out = {*reading.without, *drop}
     out: list[FrameRow] = []
     motion = GroundMotion()
     cam = camera(row)
@@ -124,8 +129,8 @@ def collect_run(
         p = phi[f.k] if f.k < len(phi) else None
         if p is not None and math.isfinite(p):
             history.add(f.features.timestamp, p)
-        if truth:
-            values = truth_values(row, delayed(row, f.k, delay))
+        if reading.truth:
+            values = truth_values(row, delayed(row, f.k, reading.delay))
         else:
             kin = motion.kinematics()
             values = {
@@ -139,8 +144,9 @@ def collect_run(
                 "path_offset": g.path_offset,
                 "path_distance": g.path_distance,
             }
-            if recent:
+            if reading.recent:
                 values.update(recent_velocity(row, f, cam, motion, measured))
+        values = {a: v for a, v in values.items() if a not in leave_out}
         intent = labels[f.k] if f.k < len(labels) else None
         out.append(FrameRow(i, f.k, values, intent))
         return None
@@ -438,13 +444,8 @@ def main(argv: list[str] | None = None) -> int:
     for reading in readings:
         print(f"{reading.name}: replaying {len(rows)} runs", file=sys.stderr, flush=True)
         frames = [
-            fr
-            for i, row in enumerate(rows)
-            for fr in collect_run(i, row, reading.truth, reading.delay, reading.recent)
+            fr for i, row in enumerate(rows) for fr in collect_run(i, row, reading, args.without)
         ]
-        for fr in frames:
-            for a in (*args.without, *reading.without):
-                fr.values.pop(a, None)
         lines.append(
             f"- `{reading.name}`: {len(frames)} frames with a ground point; attributes "
             f"{', '.join(frames[0].values)}."

@@ -40,8 +40,8 @@ from matplotlib.figure import Figure
 from monopic.errors import UserError
 from monopic.output import atomic_path
 from sim.analysis.realism import STEP, read_tracks
+from sim.analysis.tracks import run_track
 from sim.runs.sweep import expand_spec, load_spec
-from sim.scenario.path import pedestrian_path
 
 ROOT = Path(__file__).resolve().parents[1]
 # Real data is read where it is kept, never copied: $MONOPIC_SHARED_DATA, else
@@ -249,7 +249,7 @@ def simulated_group(name: str, spec: Path, walkers: int, step: float) -> TrackGr
     """The first `walkers` kerb-stop runs of a dataset spec, drawn as `monopic dataset`
     draws them (more runs than the spec's extend its own draws), each walked by its
     behaviour with the run's seed and sampled every `step` s from t = 0 to AFTER_RUN past
-    the run's end (sim.analysis.tracks samples a run the same way at 0.4 s)."""
+    the run's end (sim.analysis.tracks.run_track)."""
     base = load_spec(spec)
     includes = []
     for inc in base.includes:
@@ -260,10 +260,8 @@ def simulated_group(name: str, spec: Path, walkers: int, step: float) -> TrackGr
         raise UserError(f"{spec}: no [[include]] draws {FAMILY_FILE}")
     tracks, plan = [], []
     for run in expand_spec(replace(base, includes=tuple(includes)))[:walkers]:
-        s = run.scenario
-        track = pedestrian_path(s.pedestrian, s.duration + AFTER_RUN, s.seed)
-        tracks.append(track.positions_at(np.arange(0.0, s.duration + AFTER_RUN + 1e-9, step)))
-        plan.append(s.pedestrian.speed)
+        tracks.append(run_track(run, step, AFTER_RUN).positions)
+        plan.append(run.scenario.pedestrian.speed)
     shown = spec.relative_to(ROOT) if spec.is_relative_to(ROOT) else spec
     notes = (
         f"`{shown}`, the kerb-stop family's first {len(tracks)} runs (walking "

@@ -26,7 +26,8 @@ from sim.scenario.path import pedestrian_path
 
 @dataclass(frozen=True)
 class RunTrack:
-    """One run's pedestrian, sampled every STEP seconds over the run."""
+    """One run's pedestrian, sampled every STEP seconds over the run (or as run_track is
+    told)."""
 
     run: str
     family: str
@@ -34,10 +35,11 @@ class RunTrack:
     positions: np.ndarray  # (n, 2) world x, y in metres
 
 
-def run_track(spec: RunSpec) -> RunTrack:
+def run_track(spec: RunSpec, step: float = STEP, after: float = 0.0) -> RunTrack:
+    """The run's pedestrian every `step` s from t = 0 to `after` s past the run's end."""
     s = spec.scenario
-    path = pedestrian_path(s.pedestrian, s.duration, s.seed)
-    times = np.arange(0.0, s.duration + 1e-9, STEP)
+    path = pedestrian_path(s.pedestrian, s.duration + after, s.seed)
+    times = np.arange(0.0, s.duration + after + 1e-9, step)
     return RunTrack(spec.id, spec.family or s.family, s.pedestrian.behaviour.model,
                     path.positions_at(times))  # fmt: skip
 
