@@ -15,7 +15,8 @@ file; the estimator that produced the file should agree on nearly all (foot poin
 stored to 0.1 px).
 
     .venv/bin/python bench/ground_replay.py recordings/medium-s4.jsonl \
-        [--acceleration 1.5 3] [--initial-speed 2] [--plot errors.png] [--no-append]
+        [--acceleration 1.5 3] [--initial-speed 2] [--column-noise 0.3+0.01]
+        [--plot errors.png] [--no-append]
 """
 
 from __future__ import annotations
@@ -182,12 +183,35 @@ def load(path: Path) -> list[RunResult]:
     return rows
 
 
+def column_noise(text: str) -> tuple[float | None, float]:
+    """`--column-noise`'s PX+PER_HEIGHT, or 'row' for the shipped isotropic pixels."""
+    if text == "row":
+        return None, 0.0
+    try:
+        px, per_height = (float(x) for x in text.split("+"))
+    except ValueError:
+        raise SystemExit(
+            f"--column-noise: {text!r} is not PX+PER_HEIGHT (e.g. 0.3+0.01) or 'row'"
+        ) from None
+    if not (px > 0 and per_height >= 0):
+        raise SystemExit(f"--column-noise: {text!r}: PX must be > 0 and PER_HEIGHT >= 0")
+    return px, per_height
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("results", type=Path)
     ap.add_argument("--acceleration", type=float, nargs="+", default=[])
     ap.add_argument("--initial-speed", type=float, nargs="+", default=[])
     ap.add_argument("--pixel-noise-per-height", type=float, nargs="+", default=[])
+    ap.add_argument(
+        "--column-noise",
+        metavar="PX+PER_HEIGHT",
+        nargs="+",
+        default=[],
+        help="the foot column's own pixel noise, e.g. 0.3+0.01 (0.3 px plus 1 %% of the "
+        "apparent height); 'row' keeps the column as noisy as the row (shipped)",
+    )
     ap.add_argument("--plot", type=Path, help="PNG of the error distributions")
     ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
@@ -202,11 +226,20 @@ def main() -> None:
         args.acceleration or [shipped.acceleration],
         args.initial_speed or [shipped.initial_speed],
         args.pixel_noise_per_height or [shipped.pixel_noise_per_height],
+        [column_noise(c) for c in args.column_noise] or [(None, 0.0)],
     )
-    for a, s0, ph in grid:
-        cfg = GroundTrackConfig(acceleration=a, initial_speed=s0, pixel_noise_per_height=ph)
+    for a, s0, ph, (c0, ch) in grid:
+        cfg = GroundTrackConfig(
+            acceleration=a,
+            initial_speed=s0,
+            pixel_noise_per_height=ph,
+            column_pixel_noise=c0,
+            column_pixel_noise_per_height=ch,
+        )
         if cfg != shipped:
             name = f"Kalman, acceleration {a:g}, initial speed {s0:g}, px/height {ph:g}"
+            if c0 is not None:
+                name += f", column {c0:g} px + {ch:g} x height"
             candidates.append((name, lambda cfg=cfg: GroundMotion(cfg)))
     lines = [
         f"{len(rows)} runs of `{args.results}` replayed for {METHOD} (foot points and robot "

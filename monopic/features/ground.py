@@ -85,8 +85,9 @@ class GroundMotion:
         `apparent_height` (px) sets the foot point's pixel noise: a big, near person's
         landmarks jitter by more pixels than a small, far one's.
         """
+        row_noise, column_noise = self._pixel_noise(apparent_height)
         measured = foot_on_ground(
-            ego, foot_px, self._pixel_noise(apparent_height), self.config.min_position_noise
+            ego, foot_px, row_noise, self.config.min_position_noise, column_noise
         )
         if measured is None:
             return None
@@ -112,19 +113,29 @@ class GroundMotion:
         self._track.reset()
         self._kinematics.reset()
 
-    def _pixel_noise(self, apparent_height: float) -> float:
+    def _pixel_noise(self, apparent_height: float) -> tuple[float, float | None]:
+        """The foot point's pixel noise (px): the row's, and the column's when it has its own."""
+        c = self.config
         h = apparent_height if math.isfinite(apparent_height) and apparent_height > 0 else 0.0
-        return self.config.pixel_noise + self.config.pixel_noise_per_height * h
+        column = None
+        if c.column_pixel_noise is not None:
+            column = c.column_pixel_noise + c.column_pixel_noise_per_height * h
+        return c.pixel_noise + c.pixel_noise_per_height * h, column
 
 
 def foot_on_ground(
-    ego: EgoState, foot_px: tuple[float, float], pixel_noise: float, min_noise: float = 0.05
+    ego: EgoState,
+    foot_px: tuple[float, float],
+    pixel_noise: float,
+    min_noise: float = 0.05,
+    column_noise: float | None = None,
 ) -> tuple[np.ndarray, np.ndarray] | None:
     """The ground point under a foot pixel and its covariance (robot frame, m and m^2).
 
-    The covariance is the isotropic pixel noise carried through the ground projection
-    (its Jacobian by central differences), so it stretches along the line of sight with
-    range. None when the pixel or its neighbourhood sees no ground (at the horizon).
+    The covariance is the pixel noise (the row's `pixel_noise`, the column's
+    `column_noise`, the same when None) carried through the ground projection (its
+    Jacobian by central differences), so it stretches along the line of sight with range.
+    None when the pixel or its neighbourhood sees no ground (at the horizon).
     """
     u, v = foot_px
     e = 0.5
@@ -133,5 +144,6 @@ def foot_on_ground(
     if not np.all(np.isfinite(g)):
         return None
     J = np.column_stack([(g[1] - g[2]) / (2 * e), (g[3] - g[4]) / (2 * e)])
-    cov = pixel_noise**2 * (J @ J.T) + min_noise**2 * np.eye(2)
+    column = pixel_noise if column_noise is None else column_noise
+    cov = J @ np.diag([column**2, pixel_noise**2]) @ J.T + min_noise**2 * np.eye(2)
     return g[0], cov

@@ -36,3 +36,13 @@ def test_by_family_counts_collisions_warned_a_second_ahead_and_near_misses_warne
     ]
     j = ground_replay.Judged("x", 1.0, outs, np.zeros(1))
     assert j.by_family() == {"cross": (1, 3), "kerb": (2, 3)}
+
+
+def test_the_column_noise_option_reads_px_plus_per_height_or_row() -> None:
+    import pytest
+
+    assert ground_replay.column_noise("0.3+0.01") == (0.3, 0.01)
+    assert ground_replay.column_noise("row") == (None, 0.0)
+    for bad in ("0.3", "a+b", "0+0.01", "0.3+-1"):
+        with pytest.raises(SystemExit, match="--column-noise"):
+            ground_replay.column_noise(bad)

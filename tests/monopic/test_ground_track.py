@@ -69,6 +69,47 @@ def test_noise_stretches_along_the_line_of_sight_and_grows_with_range() -> None:
     assert above is None
 
 
+def test_a_quieter_column_narrows_only_the_across_sight_noise() -> None:
+    # Straight ahead the column maps to the lateral axis, the row to the forward one.
+    px = tuple(CAM.project(np.array([8.0, 0.0, 0.0])))
+    same = foot_on_ground(EGO, px, 2.0, 0.0)
+    quiet = foot_on_ground(EGO, px, 2.0, 0.0, column_noise=0.5)
+    assert same is not None and quiet is not None
+    assert quiet[1][0, 0] == pytest.approx(same[1][0, 0], rel=1e-9)
+    assert quiet[1][1, 1] == pytest.approx(same[1][1, 1] / 16, rel=1e-6)
+    assert foot_on_ground(EGO, px, 2.0, 0.0, column_noise=2.0)[1] == pytest.approx(same[1])
+
+
+def test_the_column_noise_follows_the_apparent_height() -> None:
+    motion = GroundMotion(
+        GroundTrackConfig(column_pixel_noise=0.3, column_pixel_noise_per_height=0.01)
+    )
+    assert motion._pixel_noise(80.0) == pytest.approx((1.0 + 0.025 * 80, 0.3 + 0.8))
+    assert GroundMotion()._pixel_noise(80.0) == (1.0 + 0.025 * 80, None)
+    with pytest.raises(ValueError, match="column_pixel_noise"):
+        GroundTrackConfig(column_pixel_noise=0.0)
+
+
+def test_a_quieter_column_reads_a_stop_across_the_line_of_sight_sooner() -> None:
+    # A walker crossing 8 m ahead stops dead; both tracks see the same noiseless pixels
+    # (the hips' column as steady as measured). The one that believes its column reads
+    # the lateral speed fall sooner.
+    tracks = [GroundMotion(), GroundMotion(GroundTrackConfig(column_pixel_noise=0.5))]
+    lateral = {0: [], 1: []}
+    for i in range(45):
+        t = i / 15
+        y = 2.0 - 1.4 * min(t, 2.0)
+        px = CAM.project(np.array([8.0, y, 0.0]))
+        for j, m in enumerate(tracks):
+            m.observe_ego(t, EGO)
+            got = m.update(t, EGO, (float(px[0]), float(px[1])), 60.0)
+            assert got is not None
+            lateral[j].append(got[1][1])
+    # 0.2 s after the stop (frame 33): the quiet column's track has shed more of the speed
+    assert abs(lateral[1][33]) < abs(lateral[0][33]) - 0.1
+    assert lateral[1][29] == pytest.approx(-1.4, abs=0.1)  # and it walked at pace before
+
+
 def test_a_jump_is_not_believed_but_a_new_place_is_taken_after_three() -> None:
     track = GroundTrack()
     R = np.eye(2) * 0.01
