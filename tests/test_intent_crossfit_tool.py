@@ -71,6 +71,14 @@ def test_a_slowing_walker_reads_a_negative_acceleration_and_a_late_reading_misse
     assert crossfit.delayed(row, 15, 0.0) == 15
 
 
+def test_the_truths_window_is_the_same_three_frames_on_every_frame() -> None:
+    # Speeds alternate frame by frame: a window of 3 frames reads +-0.1 m/s over 0.2 s,
+    # one of 4 would read nothing. Times accumulate in floats, as the simulator's do.
+    row = walker([1.0 + 0.1 * (j % 2) for j in range(60)])
+    for k in range(4, 61):
+        assert abs(crossfit.truth_values(row, k)["acceleration"]) == pytest.approx(0.5, rel=1e-6)
+
+
 def test_no_frame_before_means_no_motion() -> None:
     v = crossfit.truth_values(walker([1.0] * 3), 0)
     assert all(math.isnan(x) for x in v.values() if x is not None)
@@ -142,6 +150,41 @@ def test_the_recent_velocity_is_the_measured_foot_points_own_over_the_last_windo
     assert math.isnan(got[2]["left_recent"])  # three points: not yet
     assert got[-1]["left_recent"] == pytest.approx(1.2, abs=1e-6)
     assert got[-1]["forward_recent"] == pytest.approx(0.0, abs=1e-6)
+
+
+def test_the_column_reading_has_its_own_track_with_the_columns_noise(monkeypatch) -> None:
+    from monopic.features.ground import GroundMotion
+    from monopic.frame import EgoState
+
+    assert crossfit.Reading.parse("pipeline-column").column
+    assert crossfit.COLUMN_TRACK.column_pixel_noise is not None
+    monkeypatch.setattr(crossfit, "camera", lambda row: CAMERA)
+    frames = [*range(8), *range(20, 26)]  # a gap of 0.8 s: beyond MAX_GAP, a restart
+    n = 26
+    row = SimpleNamespace(
+        truth=SimpleNamespace(t=[k * DT for k in range(n)], robot_speed=[0.5] * n),
+        pipelines={crossfit.MAIN: SimpleNamespace(height=[90.0] * n)},
+        scenario=SimpleNamespace(robot_width=0.6),
+    )
+    track, alone = crossfit.ColumnTrack(row), GroundMotion(crossfit.COLUMN_TRACK)
+    alone_k, prev = -1, None
+    for k in frames:
+        t = k * DT
+        foot = tuple(CAMERA.project(np.array([7.0 - 0.5 * t, -3.0 + 1.3 * t, 0.0])))
+        shipped = GroundFeatures((0.0, 0.0), (9.0, 9.0), CAMERA)  # the replay's: not used
+        f = Features(t, foot, foot, 90.0, 0.0, 0.0, 0.0, shipped)
+        g, _ = track.update(ReplayFrame(k, f, None))
+        for j in range(alone_k + 1, k + 1):
+            alone.observe_ego(j * DT, EgoState(CAMERA, 0.5, 0.0))
+        alone_k = k
+        if prev is not None and t - prev > crossfit.MAX_GAP:
+            alone.reset_track()
+        prev = t
+        want = alone.update(t, EgoState(CAMERA, 0.5, 0.0), foot, 90.0)
+        assert want is not None
+        assert g.velocity == pytest.approx(want[1]) and g.position == pytest.approx(want[0])
+    assert track.motion._track.starts == 2  # restarted after the gap
+    assert g.velocity == pytest.approx((0.0, 1.3), abs=0.15)  # the walker's own, not the robot's
 
 
 def run_tool(*args: str) -> subprocess.CompletedProcess[str]:

@@ -25,12 +25,17 @@ shows the whole trade. If no threshold meets both goals, these features cannot, 
 a tree is trained; if one does, the misses were the training ranges.
 
 Other readings ask what would: `pipeline-recent` adds the measured foot point's own
-velocity over the last 0.4 s (shorter lag, more noise); `truth` reads every attribute
+velocity over the last 0.4 s (shorter lag, more noise); `pipeline-column` reads the
+motion attributes from a second ground track whose foot column has its own, measured,
+smaller pixel noise (GroundTrackConfig.column_pixel_noise: the hips' column is steadier
+than the foot's row, so motion across the line of sight is believed sooner), the warning
+still from the shipped track; `truth` reads every attribute
 from the simulator's truth (a perfect reader, with the head's true yaw), `truth-motion`
 its motion alone, and `@S` reads the truth S seconds late, as an estimator lagging by S.
 
     .venv/bin/python tools/intent_crossfit.py RESULTS.jsonl [MORE.jsonl ...]
-        [--reading pipeline|pipeline-recent|truth|truth-motion[@S] ...] [--folds 5] [--depth 4 6]
+        [--reading pipeline|pipeline-recent|pipeline-column|truth|truth-motion[@S] ...]
+        [--folds 5] [--depth 4 6]
         [--min-rows 50] [--out docs/intent/crossfit.md] [--plot docs/images/crossfit.png]
 """
 
@@ -51,8 +56,10 @@ from matplotlib.figure import Figure
 from monopic.camera import CameraModel
 from monopic.errors import UserError
 from monopic.features.ground import GroundMotion, foot_on_ground
+from monopic.features.ground_track import GroundTrackConfig
+from monopic.features.record import GroundFeatures
 from monopic.features.swept_path import path_offset
-from monopic.features.window import SlidingWindow, angle_rate
+from monopic.features.window import Kinematics, SlidingWindow, angle_rate
 from monopic.frame import EgoState
 from monopic.output import atomic_path
 from monopic.predict.base import Prediction, with_ground_point
@@ -60,7 +67,14 @@ from monopic.replay.intent_training import quantile_cuts
 from monopic.tree.discretise import CutPointBins, Discretiser
 from monopic.tree.id3 import DecisionTree, ID3Params, fit_id3
 from monopic.tree.intent import INTENT_ATTRIBUTES, IntentRules, LeafReading, place
-from sim.analysis.ground_replay import PointRule, ReplayFrame, camera, judge_warnings, replay
+from sim.analysis.ground_replay import (
+    MAX_GAP,
+    PointRule,
+    ReplayFrame,
+    camera,
+    judge_warnings,
+    replay,
+)
 from sim.analysis.metrics import LEAD_GOAL, PairedRecall, RunOutcome, paired_recall
 from sim.runs.result import MAIN, RunResult
 from sim.runs.results_file import read_results
@@ -70,11 +84,14 @@ ATTRIBUTES = tuple(a for a in INTENT_ATTRIBUTES if a not in ("head_yaw", "head_t
 # The truth's reading adds the head's true yaw from the shoulders (the pipeline's own
 # reading of it is not in the results file, and reads a fifth of a turn: session 9).
 TRUTH_ATTRIBUTES = (*ATTRIBUTES, "head_yaw")
-# s: the truth's acceleration, heading and facing rates, from the first frame at least this
-# far back by a plain float comparison (3 or 4 frames at 15 fps: 0.2-0.27 s; `delayed`
-# allows 1e-9 and would take 3 always, which moves the truth readings' tables)
+# s: the truth's acceleration, heading and facing rates, from the last frame this far back
+# (`delayed`: 3 frames at 15 fps; until session 15 a plain float comparison took 4 on 41 %
+# of frames)
 TRUTH_WINDOW = 0.2
 RECENT_WINDOW = 0.4  # s: the `pipeline-recent` reading's line fit (about 0.2 s of lag)
+# The `pipeline-column` reading's track: the column's pixel noise as measured on the
+# development intent sweep (GroundTrackConfig's docstring), the row's as shipped.
+COLUMN_TRACK = GroundTrackConfig(column_pixel_noise=0.3, column_pixel_noise_per_height=0.01)
 PHI_RATE_WINDOW = 0.5  # s, as the feature extractor's phi rate (FeatureExtractor)
 THRESHOLDS = (0.05, 0.1, 0.15, 0.2, 0.3, 0.4, 0.5, 0.6, 0.8)
 BASELINE = "constant velocity (replayed)"
@@ -117,6 +134,7 @@ def collect_run(
     leave_out = {*reading.without, *drop}
     out: list[FrameRow] = []
     motion = GroundMotion()
+    own = ColumnTrack(row) if reading.column else None
     cam = camera(row)
     measured = SlidingWindow(RECENT_WINDOW)
     phi = row.pipelines[MAIN].phi
@@ -133,6 +151,8 @@ def collect_run(
             values = truth_values(row, delayed(row, f.k, reading.delay))
         else:
             kin = motion.kinematics()
+            if own is not None:  # the motion from the second track, the warning not
+                g, kin = own.update(f)
             values = {
                 "forward": g.velocity[0],
                 "left": g.velocity[1],
@@ -153,6 +173,40 @@ def collect_run(
 
     replay(row, motion, record)
     return out
+
+
+class ColumnTrack:
+    """A second ground track beside the replay's, fed the same foot points with
+    COLUMN_TRACK's noise model, for the `pipeline-column` reading."""
+
+    def __init__(self, row: RunResult) -> None:
+        self.row, self.cam = row, camera(row)
+        self.motion = GroundMotion(COLUMN_TRACK)
+        self.k = -1  # the last frame whose odometry is in
+        self.last: float | None = None  # the last frame with a foot point
+
+    def update(self, f: ReplayFrame) -> tuple[GroundFeatures, Kinematics]:
+        """Frame f's ground features and window kinematics from this track; where it has
+        no ground point (the horizon), the replay's own."""
+        tr, t = self.row.truth, f.features.timestamp
+        for j in range(self.k + 1, f.k + 1):  # the robot's motion on every frame, as replay
+            self.motion.observe_ego(tr.t[j], EgoState(self.cam, tr.robot_speed[j], 0.0))
+        self.k = f.k
+        if self.last is not None and t - self.last > MAX_GAP:
+            self.motion.reset_track()
+        self.last = t
+        height = self.row.pipelines[MAIN].height[f.k] or 0.0
+        ego = EgoState(self.cam, tr.robot_speed[f.k], 0.0)
+        got = self.motion.update(t, ego, f.features.foot, height)
+        g = f.features.ground
+        assert g is not None
+        if got is None:
+            return g, self.motion.kinematics()
+        side = path_offset(got[0], self.row.scenario.robot_width)
+        own = GroundFeatures(
+            got[0], got[1], self.cam, path_offset=side.offset, path_distance=side.distance
+        )
+        return own, self.motion.kinematics()
 
 
 def recent_velocity(
@@ -202,11 +256,7 @@ def truth_values(row: RunResult, k: int, window: float = TRUTH_WINDOW) -> dict[s
         return (x1 - x0) / (t1 - t0) + float(tr.robot_speed[j]), (y1 - y0) / (t1 - t0)  # type: ignore[arg-type]
 
     v1, here = velocity(k), at(k)
-    back = k
-    while (
-        back > 0 and here is not None and tr.t[back] is not None and here[0] - tr.t[back] < window
-    ):  # type: ignore[operator]
-        back -= 1
+    back = delayed(row, k, window) if here is not None else k
     v0 = velocity(back) if back < k else None
     values = dict.fromkeys(TRUTH_ATTRIBUTES, nan)
     if v1 is None or here is None:
@@ -335,6 +385,7 @@ class Reading:
     delay: float
     without: tuple[str, ...]
     recent: bool = False  # add the measured foot point's velocity over RECENT_WINDOW
+    column: bool = False  # motion from a track with the column's own noise (COLUMN_TRACK)
 
     @classmethod
     def parse(cls, text: str) -> Reading:
@@ -349,13 +400,21 @@ class Reading:
             raise UserError(f"--reading: {text!r}: the delay must be seconds >= 0")
         if delay and name.startswith("pipeline"):
             raise UserError(f"--reading: {text!r}: only the truth's reading can be made late")
-        return cls(text, name.startswith("truth"), delay, READINGS[name], name == "pipeline-recent")
+        return cls(
+            text,
+            name.startswith("truth"),
+            delay,
+            READINGS[name],
+            recent=name == "pipeline-recent",
+            column=name == "pipeline-column",
+        )
 
 
 # Each reading's attributes beyond those the tool leaves out for all (--without).
 READINGS: dict[str, tuple[str, ...]] = {
     "pipeline": (),
     "pipeline-recent": (),  # plus the foot point's velocity over the last RECENT_WINDOW
+    "pipeline-column": (),  # motion from a track with the column's own noise
     "truth": (),
     "truth-motion": ("phi", "phi_rate", "head_yaw"),  # the walker's motion alone
 }
@@ -388,9 +447,11 @@ def main(argv: list[str] | None = None) -> int:
         "--reading",
         action="append",
         metavar="NAME[@S]",
-        help="pipeline (default), truth (every attribute, a perfect reader) or truth-motion "
-        "(its motion alone); @S reads the truth S seconds late, as an estimator that lags "
-        "by S (repeatable: one table and one picture for all)",
+        help="pipeline (default), pipeline-recent (plus the foot point's velocity over the "
+        "last 0.4 s), pipeline-column (motion from a track with the column's own noise), "
+        "truth (every attribute, a perfect reader) or truth-motion (its motion alone); @S "
+        "reads the truth S seconds late, as an estimator that lags by S (repeatable: one "
+        "table and one picture for all)",
     )
     ap.add_argument("--folds", type=int, default=5)
     ap.add_argument("--depth", type=int, nargs="+", default=[4, 6])
