@@ -3,7 +3,6 @@ split into column and row, and across and along the line of sight; bad input is 
 
 from __future__ import annotations
 
-import importlib.util
 import subprocess
 import sys
 from types import SimpleNamespace
@@ -12,14 +11,10 @@ import numpy as np
 import pytest
 
 from sim.analysis.ground_replay import camera
-from tests.paths import ROOT
+from tests.paths import ROOT, load_tool
 
 TOOL = ROOT / "tools" / "foot_noise.py"
-_spec = importlib.util.spec_from_file_location("foot_noise", TOOL)
-assert _spec is not None and _spec.loader is not None
-foot_noise = importlib.util.module_from_spec(_spec)
-sys.modules["foot_noise"] = foot_noise  # dataclasses look their module up there
-_spec.loader.exec_module(foot_noise)
+foot_noise = load_tool("foot_noise")
 
 MAIN = foot_noise.MAIN
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import subprocess
 import sys
@@ -12,14 +11,10 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tests.paths import ROOT
+from tests.paths import ROOT, load_tool
 
 TOOL = ROOT / "tools" / "head_reading.py"
-_spec = importlib.util.spec_from_file_location("head_reading", TOOL)
-assert _spec is not None and _spec.loader is not None
-head_reading = importlib.util.module_from_spec(_spec)
-sys.modules["head_reading"] = head_reading
-_spec.loader.exec_module(head_reading)
+head_reading = load_tool("head_reading")
 
 PX_PER_M = 300.0
 

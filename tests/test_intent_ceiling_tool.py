@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import subprocess
 import sys
 from pathlib import Path
@@ -16,13 +15,10 @@ from monopic.predict.base import Mode
 from monopic.predict.registry import make_predictor
 from monopic.tree.intent import START_CROSSING, IntentRules
 from sim.analysis.ground_replay import ReplayFrame
-from tests.paths import ROOT
+from tests.paths import ROOT, load_tool
 
 TOOL = ROOT / "tools" / "intent_ceiling.py"
-_spec = importlib.util.spec_from_file_location("intent_ceiling", TOOL)
-assert _spec is not None and _spec.loader is not None
-intent_ceiling = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(intent_ceiling)
+intent_ceiling = load_tool("intent_ceiling")
 
 CAMERA = CameraModel.from_fov(768, 432, vertical_fov_deg=65.0, mount_height=1.2, pitch_deg=5.0)
 RULES = IntentRules(hold_back_support=0.5, warn_support=0.5, min_rows=1, start_speed=1.0)

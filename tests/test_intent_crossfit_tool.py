@@ -3,7 +3,6 @@ motion, the hold-back acts on the out-of-fold share only, and bad input is one l
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import subprocess
 import sys
@@ -18,14 +17,10 @@ from monopic.features.record import Features, GroundFeatures
 from monopic.predict.base import Mode
 from monopic.predict.registry import make_predictor
 from sim.analysis.ground_replay import ReplayFrame
-from tests.paths import ROOT
+from tests.paths import ROOT, load_tool
 
 TOOL = ROOT / "tools" / "intent_crossfit.py"
-_spec = importlib.util.spec_from_file_location("intent_crossfit", TOOL)
-assert _spec is not None and _spec.loader is not None
-crossfit = importlib.util.module_from_spec(_spec)
-sys.modules["intent_crossfit"] = crossfit  # dataclasses look their module up there
-_spec.loader.exec_module(crossfit)
+crossfit = load_tool("intent_crossfit")
 
 CAMERA = CameraModel.from_fov(768, 432, vertical_fov_deg=65.0, mount_height=1.2, pitch_deg=5.0)
 DT = 1 / 15

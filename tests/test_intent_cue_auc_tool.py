@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import math
 import subprocess
 import sys
@@ -15,13 +14,10 @@ from monopic.cases import Case
 from monopic.replay.intent_training import LabelledRow, RunRows
 from monopic.tree.intent import IntentSample
 from monopic.variants.zone import RobotGeometry
-from tests.paths import ROOT
+from tests.paths import ROOT, load_tool
 
 TOOL = ROOT / "tools" / "intent_cue_auc.py"
-_spec = importlib.util.spec_from_file_location("intent_cue_auc", TOOL)
-assert _spec is not None and _spec.loader is not None
-intent_cue_auc = importlib.util.module_from_spec(_spec)
-_spec.loader.exec_module(intent_cue_auc)
+intent_cue_auc = load_tool("intent_cue_auc")
 
 
 def labelled(

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import importlib.util
 import subprocess
 import sys
 from pathlib import Path
@@ -11,14 +10,10 @@ import numpy as np
 import pytest
 
 from sim.analysis.realism import tracks_text
-from tests.paths import ROOT
+from tests.paths import ROOT, load_tool
 
 TOOL = ROOT / "tools" / "stop_timing.py"
-_spec = importlib.util.spec_from_file_location("stop_timing", TOOL)
-assert _spec is not None and _spec.loader is not None
-stop_timing = importlib.util.module_from_spec(_spec)
-sys.modules["stop_timing"] = stop_timing  # dataclasses look their module up
-_spec.loader.exec_module(stop_timing)
+stop_timing = load_tool("stop_timing")
 
 STEP = 0.4
 
