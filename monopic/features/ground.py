@@ -144,6 +144,8 @@ def foot_on_ground(
     if not np.all(np.isfinite(g)):
         return None
     J = np.column_stack([(g[1] - g[2]) / (2 * e), (g[3] - g[4]) / (2 * e)])
-    column = pixel_noise if column_noise is None else column_noise
-    cov = J @ np.diag([column**2, pixel_noise**2]) @ J.T + min_noise**2 * np.eye(2)
+    if column_noise is None:  # isotropic: as before the column had its own noise, bit for bit
+        cov = pixel_noise**2 * (J @ J.T) + min_noise**2 * np.eye(2)
+    else:
+        cov = J @ np.diag([column_noise**2, pixel_noise**2]) @ J.T + min_noise**2 * np.eye(2)
     return g[0], cov
