@@ -85,7 +85,9 @@ def run_worker(
 ) -> Run:
     cmd, extra_env = worker_command(side, ref_python)
     cmd += ["--frames", str(frames), "--threads", str(threads), "--warmup", str(warmup)]
-    cmd += ["--model", model]
+    # The reference runs MediaPipe's float model of the same complexity: full-int8 is a
+    # quantisation of its full model.
+    cmd += ["--model", model if side == OURS else model.removesuffix("-int8")]
     if side == OURS:
         cmd += ["--runtime", runtime]
     if pin:
@@ -371,6 +373,13 @@ def main() -> None:
         default="cpu",
         help="our side's onnxruntime execution provider (monopic.pose.sessions.RUNTIMES)",
     )
+    ap.add_argument(
+        "--model",
+        choices=("full", "full-int8"),
+        default="full",
+        help="our side's landmark model (the reference runs MediaPipe's full model); "
+        "bench/model_choices.py compares lite and heavy",
+    )
     ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
     from monopic.pose.sessions import runtime_unavailable
@@ -391,7 +400,14 @@ def main() -> None:
             order = sides if rnd % 2 == 0 else sides[::-1]
             for side in order:
                 run = run_worker(
-                    side, npy, t, args.warmup, ref_python, not args.no_pin, runtime=args.runtime
+                    side,
+                    npy,
+                    t,
+                    args.warmup,
+                    ref_python,
+                    not args.no_pin,
+                    model=args.model,
+                    runtime=args.runtime,
                 )
                 loads += [run.load_before, run.load_after]
                 col.runs.append(run)
@@ -414,6 +430,7 @@ def main() -> None:
         "warmup_frames": args.warmup,
         "pinned": not args.no_pin,
         "runtime": args.runtime,
+        "model": args.model,
         "load_min": min(loads),
         "load_max": max(loads),
         "latency": [],

@@ -65,9 +65,12 @@ def ratio_at(threads: int) -> Callable[[dict[str, Any]], Standing | None]:
 
 
 def _runtime(results: dict[str, Any]) -> str:
-    """' on openvino' for a run whose pose models were not on the default runtime."""
-    runtime = results.get("runtime", "cpu")
-    return "" if runtime == "cpu" else f" on {runtime}"
+    """' on openvino' for a run whose pose models were not on the default runtime, ' with
+    full-int8' for one whose landmark model was not the default full one."""
+    runtime, model = results.get("runtime", "cpu"), results.get("model", "full")
+    return ("" if runtime == "cpu" else f" on {runtime}") + (
+        "" if model == "full" else f" with {model}"
+    )
 
 
 def cpu_ratio(results: dict[str, Any], threads: int) -> float | None:
@@ -90,7 +93,7 @@ def cpu_ratio_at(threads: int) -> Callable[[dict[str, Any]], Standing | None]:
         per = {r["side"]: r for r in results["cpu"] if r["threads"] == threads}
         return Standing(
             f"{ratio:.2f} ({per['ours']['cpu_ms_per_frame']:.1f} vs "
-            f"{per['reference']['cpu_ms_per_frame']:.1f} CPU-ms per frame)",
+            f"{per['reference']['cpu_ms_per_frame']:.1f} CPU-ms per frame){_runtime(results)}",
             ratio <= RATIO_GOAL,
         )
 

@@ -7,7 +7,7 @@ as shipped: the pruned landmark model and MediaPipe's heatmap refinement
 (monopic.pose.landmarks.refine_from_heatmap), as in the reference graph.
 
     .venv/bin/python bench/pipeline_worker.py --frames recordings/bench/frames-*.npy --threads 1
-        [--model lite|full|heavy] [--runtime cpu|openvino]
+        [--model lite|full|heavy|full-int8] [--runtime cpu|openvino]
 """
 
 from __future__ import annotations
@@ -63,7 +63,7 @@ class OurRunner:
 
 
 def options(ap: argparse.ArgumentParser) -> None:
-    ap.add_argument("--model", choices=("lite", "full", "heavy"), default="full")
+    ap.add_argument("--model", choices=("lite", "full", "heavy", "full-int8"), default="full")
     ap.add_argument("--runtime", choices=("cpu", "openvino"), default="cpu")
 
 

@@ -16,17 +16,22 @@ DETECTOR_FILE = "pose_detection.onnx"
 # MediaPipe's three landmark models (its model_complexity 0, 1, 2), all converted by
 # `make models` from MediaPipe's own files (monopic/pose/models/NOTICE.md says where each
 # comes from). Full is the one the paper and MediaPipe's Pose solution use by default.
+# full-int8 is the full model quantised (`make models-int8`; int8 weights and activations,
+# its stem and regression branch kept float): 0.74-0.82 of the full model's time on an
+# AVX-512 VNNI core, its landmark error equal to the full model's within the paired
+# interval (issue 21; docs/benchmarks.md, session 15).
 LANDMARK_MODELS = {
     "lite": "pose_landmark_lite.onnx",
     "full": "pose_landmark_full.onnx",
     "heavy": "pose_landmark_heavy.onnx",
+    "full-int8": "pose_landmark_full_int8.onnx",
 }
 DEFAULT_LANDMARK_MODEL = "full"
 LANDMARK_FILE = LANDMARK_MODELS[DEFAULT_LANDMARK_MODEL]
 
 
 def landmark_file(model: str) -> str:
-    """The shipped file of landmark model `model` (lite, full or heavy)."""
+    """The shipped file of landmark model `model` (lite, full, heavy or full-int8)."""
     try:
         return LANDMARK_MODELS[model]
     except KeyError:

@@ -324,3 +324,11 @@ def test_a_goal_is_judged_on_the_latest_quiet_run_not_a_loaded_one() -> None:
     assert "a newer run, 2026-11-23 10:30 UTC, ran at load 15.4 before, 13.6 after" in goals
     only_loaded = render([loaded], HISTORY).split("## Ours / reference by host")[0]
     assert "| 0.04 (17.60 vs 422.80 ms) | not judged: load 15.4 before, 13.6 after" in only_loaded
+
+
+def test_a_goal_names_a_runtime_or_landmark_model_that_is_not_the_default() -> None:
+    from goals import _runtime
+
+    assert _runtime({}) == "" and _runtime({"runtime": "cpu", "model": "full"}) == ""
+    assert _runtime({"runtime": "openvino"}) == " on openvino"
+    assert _runtime({"model": "full-int8"}) == " with full-int8"
