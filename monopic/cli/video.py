@@ -88,8 +88,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         choices=list(LANDMARK_MODELS),
         default=DEFAULT_LANDMARK_MODEL,
         help="landmark model: lite, full or heavy (MediaPipe's model_complexity 0, 1, 2), or "
-        "full-int8 (the full model quantised: faster on CPUs with VNNI, same landmark "
-        "error); default %(default)s",
+        "full-int8 (the full model quantised: faster at one thread on CPUs with VNNI, same "
+        "landmark error); default %(default)s",
     )
     p.add_argument(
         "--runtime",

@@ -17,9 +17,9 @@ DETECTOR_FILE = "pose_detection.onnx"
 # `make models` from MediaPipe's own files (monopic/pose/models/NOTICE.md says where each
 # comes from). Full is the one the paper and MediaPipe's Pose solution use by default.
 # full-int8 is the full model quantised (`make models-int8`; int8 weights and activations,
-# its stem and regression branch kept float): 0.74-0.82 of the full model's time on an
-# AVX-512 VNNI core, its landmark error equal to the full model's within the paired
-# interval (issue 21; docs/benchmarks.md, session 15).
+# its stem and regression branch kept float): 0.74-0.82 of the full model's time at one
+# thread on an AVX-512 VNNI core, no faster at two; its landmark error equal to the full
+# model's within the paired interval (issue 21; docs/benchmarks.md, session 15).
 LANDMARK_MODELS = {
     "lite": "pose_landmark_lite.onnx",
     "full": "pose_landmark_full.onnx",
