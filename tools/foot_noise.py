@@ -85,10 +85,9 @@ def run_samples(row: RunResult) -> tuple[list[PixelSample], list[VelocitySample]
     velocities: list[VelocitySample] = []
     if len(t_) < 6:
         return pixels, velocities
-    ts = np.asarray(t_)
-    odo = fixed_offsets(row, ts)
-    m = np.asarray(meas) + odo
-    g_true = np.asarray(true) + odo
+    # Both in the robot's frame: the robot's own motion moves both alike and cancels in
+    # the difference of the two fits.
+    ts, m, g_true = np.asarray(t_), np.asarray(meas), np.asarray(true)
     for i in range(len(ts)):
         sel = (ts > ts[i] - FIT_WINDOW - 1e-9) & (ts <= ts[i])
         if sel.sum() < 5:
@@ -96,26 +95,13 @@ def run_samples(row: RunResult) -> tuple[list[PixelSample], list[VelocitySample]
         x = ts[sel] - ts[i]
         vm = np.polyfit(x, m[sel], 1)[0]
         vt = np.polyfit(x, g_true[sel], 1)[0]
-        sight = g_true[i] - odo[i] - eye
+        sight = g_true[i] - eye
         r = float(np.linalg.norm(sight))
         u = sight / max(r, 1e-6)
         n = np.array([-u[1], u[0]])
         d = vm - vt
         velocities.append(VelocitySample(row.scale, r, float(d @ n), float(d @ u)))
     return pixels, velocities
-
-
-def fixed_offsets(row: RunResult, ts: np.ndarray) -> np.ndarray:
-    """The robot's travel (m, forward) at each time: robot-frame points plus it are fixed
-    points (the test bed's robots drive straight)."""
-    t = np.asarray([np.nan if v is None else v for v in row.truth.t], dtype=float)
-    v = np.asarray([0.0 if s is None else s for s in row.truth.robot_speed], dtype=float)
-    ok = np.isfinite(t)
-    t, v = t[ok], v[ok]
-    travel = np.concatenate([[0.0], np.cumsum(0.5 * (v[1:] + v[:-1]) * np.diff(t))])
-    out = np.zeros((len(ts), 2))
-    out[:, 0] = np.interp(ts, t, travel)
-    return out
 
 
 def table(
