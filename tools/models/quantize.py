@@ -171,8 +171,8 @@ def _session(model: onnx.ModelProto, tensors: list[str]) -> ort.InferenceSession
 
 
 def _feeds(crops: np.ndarray, name: str) -> list[dict[str, np.ndarray]]:
-    """Landmark-model feeds of uint8 crops (u8 / 255, as `Crops` gives the calibrator)."""
-    return [{name: (c.astype(np.float32) / 255.0)[None]} for c in crops]
+    """Landmark-model feeds of uint8 crops, as `Crops` gives them to the calibrator."""
+    return list(iter(Crops(crops, name).get_next, None))
 
 
 def _clip6_pairs(model: onnx.ModelProto) -> list[tuple[onnx.NodeProto, list[onnx.NodeProto]]]:
@@ -444,16 +444,16 @@ def main() -> int:
         for v in [*inferred.graph.value_info, *inferred.graph.output]
     }
     convs = [n for n in model.graph.node if n.op_type == "Conv"]
+    depthwise = [n.name for n in convs if _attr(n, "group", 1) > 1]
     exclude = [n.name for n in convs if args.deep_only and side[n.output[0]] > args.deep_only]
     if args.detector:  # depthwise (group > 1) convolutions stay float
-        depthwise = [n for n in convs if any(a.name == "group" and a.i > 1 for a in n.attribute)]
-        exclude += [n.name for n in depthwise]
+        exclude += depthwise
         if args.keep_heads:  # the six output convolutions (boxes, keypoints, scores)
             exclude += [n.name for n in convs if n.name in _head_convs(model)]
     if args.keep_outputs:
         exclude += _output_tails(model)
     if args.float_depthwise and not args.detector:
-        exclude += [n.name for n in convs if _attr(n, "group", 1) > 1]
+        exclude += depthwise
     if args.float_ends:
         exclude += [n.name for n in convs[:3]] + _regression_branch(model)
     args.out.parent.mkdir(parents=True, exist_ok=True)
