@@ -16,7 +16,7 @@ from monopic.camera import CameraModel
 from monopic.features.record import Features, GroundFeatures
 from monopic.predict.base import Mode
 from monopic.predict.registry import make_predictor
-from sim.analysis.ground_replay import ReplayFrame
+from sim.analysis.ground_replay import MAX_GAP, ReplayFrame
 from tests.paths import ROOT, load_tool
 
 TOOL = ROOT / "tools" / "intent_crossfit.py"
@@ -147,39 +147,46 @@ def test_the_recent_velocity_is_the_measured_foot_points_own_over_the_last_windo
     assert got[-1]["forward_recent"] == pytest.approx(0.0, abs=1e-6)
 
 
-def test_the_column_reading_has_its_own_track_with_the_columns_noise(monkeypatch) -> None:
+def test_the_column_reading_has_its_own_track_with_the_columns_noise() -> None:
     from monopic.features.ground import GroundMotion
     from monopic.frame import EgoState
 
     assert crossfit.Reading.parse("pipeline-column").column
     assert crossfit.COLUMN_TRACK.column_pixel_noise is not None
-    monkeypatch.setattr(crossfit, "camera", lambda row: CAMERA)
     frames = [*range(8), *range(20, 26)]  # a gap of 0.8 s: beyond MAX_GAP, a restart
     n = 26
+    feet = [
+        tuple(CAMERA.project(np.array([7.0 - 0.5 * k * DT, -3.0 + 1.3 * k * DT, 0.0])))
+        if k in frames
+        else None
+        for k in range(n)
+    ]
+    cam = SimpleNamespace(width=768, height=432, vertical_fov_deg=65.0, mount_height=1.2,
+                          pitch_deg=5.0)  # fmt: skip  # CAMERA's
     row = SimpleNamespace(
+        scale="small",
         truth=SimpleNamespace(t=[k * DT for k in range(n)], robot_speed=[0.5] * n),
-        pipelines={crossfit.MAIN: SimpleNamespace(height=[90.0] * n)},
-        scenario=SimpleNamespace(robot_width=0.6),
-    )
-    track, alone = crossfit.ColumnTrack(row), GroundMotion(crossfit.COLUMN_TRACK)
-    alone_k, prev = -1, None
-    for k in frames:
+        pipelines={crossfit.MAIN: SimpleNamespace(
+            found=[int(f is not None) for f in feet], foot=feet, height=[90.0] * n)},
+        scenario=SimpleNamespace(robot_width=0.6, robot_length=0.8, horizon=1.5, camera=cam),
+    )  # fmt: skip
+    got = crossfit.column_motion(row)
+    assert sorted(got) == frames
+    alone, prev = GroundMotion(crossfit.COLUMN_TRACK), None
+    for k in range(n):
         t = k * DT
-        foot = tuple(CAMERA.project(np.array([7.0 - 0.5 * t, -3.0 + 1.3 * t, 0.0])))
-        shipped = GroundFeatures((0.0, 0.0), (9.0, 9.0), CAMERA)  # the replay's: not used
-        f = Features(t, foot, foot, 90.0, 0.0, 0.0, 0.0, shipped)
-        g, _ = track.update(ReplayFrame(k, f, None))
-        for j in range(alone_k + 1, k + 1):
-            alone.observe_ego(j * DT, EgoState(CAMERA, 0.5, 0.0))
-        alone_k = k
-        if prev is not None and t - prev > crossfit.MAX_GAP:
+        alone.observe_ego(t, EgoState(CAMERA, 0.5, 0.0))
+        if feet[k] is None:
+            continue
+        if prev is not None and t - prev > MAX_GAP:
             alone.reset_track()
         prev = t
-        want = alone.update(t, EgoState(CAMERA, 0.5, 0.0), foot, 90.0)
+        want = alone.update(t, EgoState(CAMERA, 0.5, 0.0), feet[k], 90.0)
         assert want is not None
+        g, _ = got[k]
         assert g.velocity == pytest.approx(want[1]) and g.position == pytest.approx(want[0])
-    assert track.motion._track.starts == 2  # restarted after the gap
-    assert g.velocity == pytest.approx((0.0, 1.3), abs=0.15)  # the walker's own, not the robot's
+    assert alone._track.starts == 2  # restarted after the gap
+    assert got[25][0].velocity == pytest.approx((0.0, 1.3), abs=0.15)  # the walker's own
 
 
 def run_tool(*args: str) -> subprocess.CompletedProcess[str]:

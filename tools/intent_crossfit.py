@@ -68,7 +68,6 @@ from monopic.tree.discretise import CutPointBins, Discretiser
 from monopic.tree.id3 import DecisionTree, ID3Params, fit_id3
 from monopic.tree.intent import INTENT_ATTRIBUTES, IntentRules, LeafReading, place
 from sim.analysis.ground_replay import (
-    MAX_GAP,
     PointRule,
     ReplayFrame,
     camera,
@@ -134,7 +133,7 @@ def collect_run(
     leave_out = {*reading.without, *drop}
     out: list[FrameRow] = []
     motion = GroundMotion()
-    own = ColumnTrack(row) if reading.column else None
+    own = column_motion(row) if reading.column else None
     cam = camera(row)
     measured = SlidingWindow(RECENT_WINDOW)
     phi = row.pipelines[MAIN].phi
@@ -152,7 +151,7 @@ def collect_run(
         else:
             kin = motion.kinematics()
             if own is not None:  # the motion from the second track, the warning not
-                g, kin = own.update(f)
+                g, kin = own.get(f.k, (g, kin))
             values = {
                 "forward": g.velocity[0],
                 "left": g.velocity[1],
@@ -175,38 +174,19 @@ def collect_run(
     return out
 
 
-class ColumnTrack:
-    """A second ground track beside the replay's, fed the same foot points with
-    COLUMN_TRACK's noise model, for the `pipeline-column` reading."""
+def column_motion(row: RunResult) -> dict[int, tuple[GroundFeatures, Kinematics]]:
+    """Per frame, the ground features and window kinematics of a second track fed the same
+    foot points with COLUMN_TRACK's noise model (the `pipeline-column` reading): the run
+    replayed through it as through the shipped track."""
+    motion = GroundMotion(COLUMN_TRACK)
+    out: dict[int, tuple[GroundFeatures, Kinematics]] = {}
 
-    def __init__(self, row: RunResult) -> None:
-        self.row, self.cam = row, camera(row)
-        self.motion = GroundMotion(COLUMN_TRACK)
-        self.k = -1  # the last frame whose odometry is in
-        self.last: float | None = None  # the last frame with a foot point
+    def record(f: ReplayFrame) -> None:
+        assert f.features.ground is not None
+        out[f.k] = (f.features.ground, motion.kinematics())
 
-    def update(self, f: ReplayFrame) -> tuple[GroundFeatures, Kinematics]:
-        """Frame f's ground features and window kinematics from this track; where it has
-        no ground point (the horizon), the replay's own."""
-        tr, t = self.row.truth, f.features.timestamp
-        for j in range(self.k + 1, f.k + 1):  # the robot's motion on every frame, as replay
-            self.motion.observe_ego(tr.t[j], EgoState(self.cam, tr.robot_speed[j], 0.0))
-        self.k = f.k
-        if self.last is not None and t - self.last > MAX_GAP:
-            self.motion.reset_track()
-        self.last = t
-        height = self.row.pipelines[MAIN].height[f.k] or 0.0
-        ego = EgoState(self.cam, tr.robot_speed[f.k], 0.0)
-        got = self.motion.update(t, ego, f.features.foot, height)
-        g = f.features.ground
-        assert g is not None
-        if got is None:
-            return g, self.motion.kinematics()
-        side = path_offset(got[0], self.row.scenario.robot_width)
-        own = GroundFeatures(
-            got[0], got[1], self.cam, path_offset=side.offset, path_distance=side.distance
-        )
-        return own, self.motion.kinematics()
+    replay(row, motion, record)
+    return out
 
 
 def recent_velocity(
