@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 
 from monopic.errors import UserError
-from monopic.output import atomic_path
+from monopic.output import write_text_atomically
 from sim.analysis.ground_replay import camera
 from sim.runs.result import MAIN, RunResult
 from sim.runs.results_file import read_results
@@ -161,8 +161,7 @@ def main(argv: list[str] | None = None) -> int:
     ]) + "\n"  # fmt: skip
     print(text)
     if args.out:
-        with atomic_path(args.out) as tmp:
-            tmp.write_text(text)
+        write_text_atomically(args.out, text)
     return 0
 
 

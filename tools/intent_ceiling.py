@@ -27,7 +27,7 @@ from pathlib import Path
 
 from monopic.errors import UserError
 from monopic.features.ground import GroundMotion
-from monopic.output import atomic_path
+from monopic.output import write_text_atomically
 from monopic.predict.base import Prediction, with_ground_point
 from monopic.tree.intent import START_CROSSING, IntentRules, LeafReading, place
 from monopic.tree.serialise import load_intent_model
@@ -196,8 +196,7 @@ def main(argv: list[str] | None = None) -> int:
     text = "\n".join(lines) + "\n"
     print(text)
     if args.out:
-        with atomic_path(args.out) as tmp:
-            tmp.write_text(text)
+        write_text_atomically(args.out, text)
     return 0
 
 

@@ -61,7 +61,7 @@ from monopic.features.record import GroundFeatures
 from monopic.features.swept_path import path_offset
 from monopic.features.window import Kinematics, SlidingWindow, angle_rate
 from monopic.frame import EgoState
-from monopic.output import atomic_path
+from monopic.output import atomic_path, write_text_atomically
 from monopic.predict.base import Prediction, with_ground_point
 from monopic.replay.intent_training import quantile_cuts
 from monopic.tree.discretise import CutPointBins, Discretiser
@@ -516,8 +516,7 @@ def main(argv: list[str] | None = None) -> int:
     text = "\n".join([*lines, "", *table]) + "\n"
     print(text)
     if args.out:
-        with atomic_path(args.out) as tmp:
-            tmp.write_text(text)
+        write_text_atomically(args.out, text)
     if args.plot:
         draw(curves, args.plot, " + ".join(p.name for p in args.results))
     return 0

@@ -38,7 +38,7 @@ import numpy as np
 from matplotlib.figure import Figure
 
 from monopic.errors import UserError
-from monopic.output import atomic_path
+from monopic.output import atomic_path, write_text_atomically
 from sim.analysis.realism import STEP, read_tracks
 from sim.analysis.tracks import run_track
 from sim.runs.sweep import expand_spec, load_spec
@@ -462,8 +462,7 @@ def main(argv: list[str] | None = None) -> int:
     link = os.path.relpath(args.plot.resolve(), args.out.resolve().parent)
     text = report_text(sets, settings, command, link, (LOOSE, results[LOOSE][1]))
     plot_stops([*scenes, *(st for st in sets if st.kind == "simulated")], settings, args.plot)
-    with atomic_path(args.out) as tmp:
-        tmp.write_text(text)
+    write_text_atomically(args.out, text)
     print("\n".join(summary(sets, settings)))
     print(f"wrote {args.out} and {args.plot}")
     return 0
