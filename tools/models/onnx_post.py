@@ -157,7 +157,7 @@ def keep_outputs(model: onnx.ModelProto, names: Sequence[str]) -> int:
     return removed
 
 
-def fold_pad_into_conv(model: onnx.ModelProto) -> int:
+def fold_pad_into_conv(model: onnx.ModelProto, direct: bool = False) -> int:
     """Move zero Pads that reach a Conv through a layout Transpose into the Conv's pads.
 
     tf2onnx writes TFLite's explicit SAME padding of the first, strided convolution as
@@ -167,6 +167,11 @@ def fold_pad_into_conv(model: onnx.ModelProto) -> int:
     kernel time on a loaded host, bench/landmark_profile.py). Rewired as Transpose ->
     Conv with the pad amounts in the Conv's `pads` (permuted to NCHW), the outputs are
     the same. Returns the number of Pads folded.
+
+    `direct` also folds the Pads a Conv reads directly. The float file keeps those
+    (onnxruntime fuses them at load), but a quantised graph holds each one between a
+    DequantizeLinear and a QuantizeLinear, which onnxruntime leaves as three kernels on
+    the full-resolution tensor (about 1 ms a frame of the int8 landmark model, issue 21).
     """
     graph = model.graph
     inits = {i.name: i for i in graph.initializer}
@@ -186,20 +191,22 @@ def fold_pad_into_conv(model: onnx.ModelProto) -> int:
         ):
             continue
         nexts = users.get(pad.output[0], [])
-        if len(nexts) != 1 or nexts[0].op_type != "Transpose":
+        if len(nexts) != 1 or nexts[0].op_type not in ("Transpose", "Conv"):
             continue
-        transpose = nexts[0]
-        perm = list(next(a.ints for a in transpose.attribute if a.name == "perm"))
-        convs = users.get(transpose.output[0], [])
-        if (
-            len(convs) != 1
-            or convs[0].op_type != "Conv"
-            or convs[0].input[0] != transpose.output[0]
-        ):
+        amounts = numpy_helper.to_array(inits[pad.input[1]]).astype(int)
+        rank = len(amounts) // 2
+        if nexts[0].op_type == "Transpose":
+            reader = nexts[0]
+            perm = list(next(a.ints for a in reader.attribute if a.name == "perm"))
+        elif direct:
+            reader, perm = None, list(range(rank))
+        else:
+            continue
+        conv_input = pad.output[0] if reader is None else reader.output[0]
+        convs = [nexts[0]] if reader is None else users.get(conv_input, [])
+        if len(convs) != 1 or convs[0].op_type != "Conv" or convs[0].input[0] != conv_input:
             continue
         conv = convs[0]
-        amounts = numpy_helper.to_array(inits[pad.input[1]]).astype(int)
-        rank = len(perm)
         begin, end = amounts[:rank][perm], amounts[rank:][perm]  # in the Conv's axis order
         if begin[:2].any() or end[:2].any():
             continue  # padding batch or channels is not a Conv padding
@@ -212,7 +219,7 @@ def fold_pad_into_conv(model: onnx.ModelProto) -> int:
         kept = [a for a in conv.attribute if a.name != "pads"]
         del conv.attribute[:]
         conv.attribute.extend([*kept, helper.make_attribute("pads", new)])
-        transpose.input[0] = pad.input[0]
+        (conv if reader is None else reader).input[0] = pad.input[0]
         folded.append(pad)
     for pad in folded:
         graph.node.remove(pad)
