@@ -101,9 +101,10 @@ def letterbox(image: np.ndarray, win: Window, size: int):
     m_idx = m.copy()
     m_idx[:, 2] += 0.5 * scale - 0.5  # sample at pixel centres
     resized = warp(image, m_idx, (size, size), cv2.INTER_AREA if scale < 1 else cv2.INTER_LINEAR)
-    # In place after one scaled pass from uint8: the same values, no temporaries.
-    tensor = np.multiply(resized, np.float32(2.0 / 255.0), dtype=np.float32)
-    np.subtract(tensor, np.float32(1.0), out=tensor)
+    # Cast, then scale and shift in place: no temporaries.
+    tensor = resized.astype(np.float32)
+    tensor *= np.float32(2.0 / 255.0)
+    tensor -= np.float32(1.0)
 
     def to_frame(norm: np.ndarray) -> np.ndarray:
         t = np.asarray(norm, dtype=float) * size

@@ -94,8 +94,9 @@ class LandmarkModel:
 
     def run(self, image: np.ndarray, region: Region) -> Pose:
         crop = region.crop(image, INPUT_SIZE)
-        # One pass from uint8 (astype, then a scaled copy, cost 0.4 ms more a frame).
-        tensor = np.multiply(crop, np.float32(1.0 / 255.0), dtype=np.float32)
+        # Cast, then scale in place: the same float32 values as one scaled cast, no temporary.
+        tensor = crop.astype(np.float32)
+        tensor *= np.float32(1.0 / 255.0)
         points, flag, heatmap = self.session.run(self.output_names, {self.input_name: tensor[None]})
         pts = points.reshape(NUM_POINTS, 5).astype(np.float64)
         # (H, W, C) view of the channels-first map: no copy, the refinement gathers 7x7.

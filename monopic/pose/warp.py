@@ -26,8 +26,9 @@ def four_channel(image: np.ndarray) -> np.ndarray:
 def warp(image: np.ndarray, matrix: np.ndarray, size: tuple[int, int], flags: int) -> np.ndarray:
     """cv2.warpAffine of the image's colour channels into `size` (w, h), zero outside.
 
-    Returns an (h, w, 3) view of the four-channel result (the models' float conversion
-    reads it in one pass).
+    Returns a contiguous (h, w, 3) copy of the result's colour channels: dropping the
+    fourth channel costs 5 us, and the models' float conversion of a contiguous crop then
+    takes 40 us against 230-390 us through the strided view (session 16, one core).
     """
     out = cv2.warpAffine(
         four_channel(image),
@@ -37,4 +38,4 @@ def warp(image: np.ndarray, matrix: np.ndarray, size: tuple[int, int], flags: in
         borderMode=cv2.BORDER_CONSTANT,
         borderValue=(0, 0, 0, 0),
     )
-    return out[..., :3]
+    return cv2.cvtColor(out, cv2.COLOR_RGBA2RGB)

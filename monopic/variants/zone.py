@@ -82,7 +82,7 @@ def points_in_polygon(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
     x, y = pts[:, :1], pts[:, 1:]  # (N, 1) against the polygon's edges along axis 1
     poly = np.asarray(polygon, dtype=float)
     x1, y1 = poly[:, 0], poly[:, 1]
-    x2, y2 = np.roll(x1, -1), np.roll(y1, -1)
+    x2, y2 = np.concatenate((x1[1:], x1[:1])), np.concatenate((y1[1:], y1[:1]))  # next vertex
     crosses = (y1 > y) != (y2 > y)
     with np.errstate(divide="ignore", invalid="ignore"):
         xi = x1 + (y - y1) * (x2 - x1) / (y2 - y1)

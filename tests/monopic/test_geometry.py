@@ -8,7 +8,7 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from monopic.camera import CameraModel
-from monopic.features.orientation import facing_angle, look_at, quaternion
+from monopic.features.orientation import _cross, facing_angle, look_at, quaternion
 from monopic.pose.anchors import ssd_anchor_centres
 from monopic.pose.detector import Detection, letterbox, weighted_nms
 from monopic.pose.region import Region
@@ -113,6 +113,12 @@ def test_weighted_nms_merges_overlaps_and_keeps_separate_people():
 def test_look_at_is_a_rotation():
     r = look_at(np.array([0, 0, 0.0]), np.array([3, 1, 2.0]))
     assert np.allclose(r @ r.T, np.eye(3)) and np.linalg.det(r) == pytest.approx(1.0)
+
+
+@given(st.lists(st.floats(-1e6, 1e6), min_size=6, max_size=6))
+def test_look_at_cross_product_is_numpys_bit_for_bit(xs):
+    a, b = np.array(xs[:3]), np.array(xs[3:])
+    assert np.array_equal(_cross(a, b), np.cross(a, b))
 
 
 @given(st.floats(-89.0, 89.0))
