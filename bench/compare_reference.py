@@ -82,14 +82,15 @@ def run_worker(
     pin: bool,
     model: str = "full",
     runtime: str = "cpu",
+    detector: str = "float",
 ) -> Run:
     cmd, extra_env = worker_command(side, ref_python)
     cmd += ["--frames", str(frames), "--threads", str(threads), "--warmup", str(warmup)]
     # The reference runs MediaPipe's float model of the same complexity: full-int8 is a
     # quantisation of its full model.
     cmd += ["--model", model if side == OURS else model.removesuffix("-int8")]
-    if side == OURS:
-        cmd += ["--runtime", runtime]
+    if side == OURS:  # the reference runs MediaPipe's own (float) detector
+        cmd += ["--runtime", runtime, "--detector", detector]
     if pin:
         cmd.append("--pin")
     env = dict(os.environ, **extra_env)
@@ -380,6 +381,12 @@ def main() -> None:
         help="our side's landmark model (the reference runs MediaPipe's full model); "
         "bench/model_choices.py compares lite and heavy",
     )
+    ap.add_argument(
+        "--detector",
+        choices=("float", "int8"),
+        default="float",
+        help="our side's person detector (the reference runs MediaPipe's)",
+    )
     ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
     from monopic.pose.sessions import runtime_unavailable
@@ -408,6 +415,7 @@ def main() -> None:
                     not args.no_pin,
                     model=args.model,
                     runtime=args.runtime,
+                    detector=args.detector,
                 )
                 loads += [run.load_before, run.load_after]
                 col.runs.append(run)
@@ -431,6 +439,7 @@ def main() -> None:
         "pinned": not args.no_pin,
         "runtime": args.runtime,
         "model": args.model,
+        "detector": args.detector,
         "load_min": min(loads),
         "load_max": max(loads),
         "latency": [],
@@ -456,7 +465,8 @@ def main() -> None:
     seqs = ", ".join(fs.sequences)
     lines = [
         f"{n} frames 768x432 in {len(fs.sequences)} sequences ({seqs}); "
-        f"sides {', '.join(sides)} (ours on onnxruntime's {args.runtime} execution provider); "
+        f"sides {', '.join(sides)} (ours on onnxruntime's {args.runtime} execution provider, "
+        f"landmark model {args.model}, {args.detector} detector); "
         f"{args.rounds} ABBA rounds per thread count, {args.warmup} warm-up frames per run; "
         f"workers pinned to N cores: {not args.no_pin}; "
         f"load average during the runs {min(loads):.1f}-{max(loads):.1f} on "

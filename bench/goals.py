@@ -66,11 +66,16 @@ def ratio_at(threads: int) -> Callable[[dict[str, Any]], Standing | None]:
 
 def _runtime(results: dict[str, Any]) -> str:
     """' on openvino' for a run whose pose models were not on the default runtime, ' with
-    full-int8' for one whose landmark model was not the default full one."""
+    full-int8' for one whose landmark model was not the default full one, ' and the int8
+    detector' (or ' with the int8 detector') for one whose detector was not the float one."""
     runtime, model = results.get("runtime", "cpu"), results.get("model", "full")
-    return ("" if runtime == "cpu" else f" on {runtime}") + (
+    detector = results.get("detector", "float")
+    text = ("" if runtime == "cpu" else f" on {runtime}") + (
         "" if model == "full" else f" with {model}"
     )
+    if detector != "float":
+        text += f" {'and' if model != 'full' else 'with'} the {detector} detector"
+    return text
 
 
 def cpu_ratio(results: dict[str, Any], threads: int) -> float | None:

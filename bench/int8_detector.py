@@ -15,8 +15,11 @@ people in the same places. Three steps:
         on the large frame set (bench/frameset.py LARGE; other seeds and distances): every
         window through both detectors (who is found, and how far the int8 detection's
         keypoints move, over the float box's height), the tracker with each detector
-        (share of frames found, sequences reset), and both timed on the same windows,
-        alternated, at 1 thread
+        (share of frames found, sequences reset; and, since the detector only seeds the
+        landmark model's region, the paired block-bootstrap interval of the landmark error
+        difference on the frames both trackers found, bench/paired.py, the clip frames
+        the calibration saw left out), and both timed on the same windows, alternated, at
+        1 thread
 
 `judge` appends one line to bench/history.jsonl unless --no-append. Nothing is shipped by
 this script: the shipped detector stays the float one unless a judged run says otherwise.
@@ -37,7 +40,8 @@ sys.path.insert(0, str(HERE))
 from alternate import alternated_ms  # noqa: E402
 from frameset import CALIBRATION, LARGE, FrameSet, build, load  # noqa: E402
 from history import Recorder  # noqa: E402
-from int8_landmarks import track  # noqa: E402
+from int8_landmarks import errors, track  # noqa: E402
+from paired import paired_mean_difference  # noqa: E402
 
 from monopic.pose.anchors import INPUT_SIZE  # noqa: E402
 from monopic.pose.detector import Detection, PoseDetector, letterbox  # noqa: E402
@@ -92,11 +96,12 @@ def best(dets: list[Detection]) -> Detection | None:
     return dets[0] if dets else None
 
 
-def tracked(fs: FrameSet, detector: PoseDetector) -> np.ndarray:
-    """Frames the shipped tracker found someone in, with `detector` as its detector."""
+def tracked(fs: FrameSet, detector: PoseDetector) -> list[np.ndarray | None]:
+    """The shipped tracker's landmarks (33, 2) or None per frame, with `detector` as its
+    detector."""
     tracker = PoseTracker(TrackerConfig(threads=1))
     tracker.detector = detector
-    return np.array([lm is not None for lm in track(fs, tracker)["landmarks"]])
+    return track(fs, tracker)["landmarks"]
 
 
 def pass_times(paths: dict[str, Path | None], tensors: list[np.ndarray], rounds: int) -> dict:
@@ -137,7 +142,16 @@ def cmd_judge(args: argparse.Namespace) -> None:
                 only_float += 1
             elif q is not None:
                 only_int8 += 1
-    found_frames = {k: tracked(fs, d) for k, d in dets.items()}
+    landmarks = {k: tracked(fs, d) for k, d in dets.items()}
+    found_frames = {k: np.array([lm is not None for lm in v]) for k, v in landmarks.items()}
+    # The clip frames the calibration frame set holds are not judged (as int8_landmarks).
+    scored = ~((fs.sequence == 0) & (np.arange(len(fs)) < (CALIBRATION.clip_frames or 0)))
+    paired = np.flatnonzero(
+        found_frames[FLOAT] & found_frames[INT8] & scored & fs.visible.any(axis=1)
+    )
+    err = {k: errors(fs, v, paired) for k, v in landmarks.items()}
+    diff = paired_mean_difference(err[INT8], err[FLOAT], fs.sequence[paired])
+    same = sum(np.array_equal(landmarks[FLOAT][i], landmarks[INT8][i]) for i in paired)
     sample = [
         letterbox(np.asarray(fs.images[i]), win, INPUT_SIZE)[0]
         for i in range(0, len(fs), max(1, len(fs) // 12))
@@ -160,6 +174,13 @@ def cmd_judge(args: argparse.Namespace) -> None:
         "keypoint_move_p95_pct": 100 * float(np.nanpercentile(moved_arr, 95)),
         "tracked_pct": {k: 100 * float(v.mean()) for k, v in found_frames.items()},
         "tracked_disagree_frames": int((found_frames[FLOAT] != found_frames[INT8]).sum()),
+        "landmark_judged_frames": len(paired),
+        "landmark_identical_frames": int(same),
+        "landmark_error_float_px": float(np.mean(np.concatenate(err[FLOAT]))),
+        "landmark_error_int8_px": float(np.mean(np.concatenate(err[INT8]))),
+        "landmark_difference_px": diff.difference,
+        "landmark_difference_low_px": diff.low,
+        "landmark_difference_high_px": diff.high,
         "pass_ms": times["ms"],
         "pass_ratio_x": times["ms"][INT8] / times["ms"][FLOAT],
     }
@@ -174,6 +195,9 @@ def cmd_judge(args: argparse.Namespace) -> None:
         f"| found by this one only | {only_float} | {only_int8} |",
         f"| frames the tracker found someone in | {results['tracked_pct'][FLOAT]:.1f} % "
         f"| {results['tracked_pct'][INT8]:.1f} % |",
+        f"| tracker's mean landmark error, {len(paired)} frames both found "
+        f"| {results['landmark_error_float_px']:.2f} px "
+        f"| {results['landmark_error_int8_px']:.2f} px |",
         f"| ms per detector pass, 1 thread (load {times['load_min']:.1f}-"
         f"{times['load_max']:.1f}) | {times['ms'][FLOAT]:.2f} | {times['ms'][INT8]:.2f} |",
         "",
@@ -182,6 +206,11 @@ def cmd_judge(args: argparse.Namespace) -> None:
         f"{results['keypoint_move_p95_pct']:.1f} % at p95. The tracker's found/not-found "
         f"differed on {results['tracked_disagree_frames']} of {len(fs)} frames. "
         f"int8 / float per pass: {results['pass_ratio_x']:.2f}.",
+        "",
+        f"The tracker's landmark error, int8 detector - float detector, on the {len(paired)} "
+        f"frames both found (clip frames 0-{(CALIBRATION.clip_frames or 0) - 1} left out; "
+        f"{same} of them with identical landmarks): {diff.difference:+.2f} "
+        f"[{diff.low:+.2f}, {diff.high:+.2f}] px (paired block bootstrap, 95 %).",
     ]
     table = "\n".join(lines)
     print(table)

@@ -7,7 +7,7 @@ as shipped: the pruned landmark model and MediaPipe's heatmap refinement
 (monopic.pose.landmarks.refine_from_heatmap), as in the reference graph.
 
     .venv/bin/python bench/pipeline_worker.py --frames recordings/bench/frames-*.npy --threads 1
-        [--model lite|full|heavy|full-int8] [--runtime cpu|openvino]
+        [--model lite|full|heavy|full-int8] [--detector float|int8] [--runtime cpu|openvino]
 """
 
 from __future__ import annotations
@@ -36,7 +36,9 @@ class OurRunner:
 
         self._frame = Frame
         self._extractor = FeatureExtractor
-        config = TrackerConfig(threads=args.threads, model=args.model, runtime=args.runtime)
+        config = TrackerConfig(
+            threads=args.threads, model=args.model, detector=args.detector, runtime=args.runtime
+        )
         self.pipeline = Pipeline(PipelineConfig(tracker=config))
 
     def reset(self) -> None:
@@ -64,6 +66,7 @@ class OurRunner:
 
 def options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--model", choices=("lite", "full", "heavy", "full-int8"), default="full")
+    ap.add_argument("--detector", choices=("float", "int8"), default="float")
     ap.add_argument("--runtime", choices=("cpu", "openvino"), default="cpu")
 
 

@@ -17,7 +17,13 @@ import numpy as np
 
 from monopic.pose.anchors import INPUT_SIZE, ssd_anchor_centres
 from monopic.pose.search import Window
-from monopic.pose.sessions import DEFAULT_RUNTIME, DETECTOR_FILE, make_session, model_path
+from monopic.pose.sessions import (
+    DEFAULT_DETECTOR_MODEL,
+    DEFAULT_RUNTIME,
+    detector_file,
+    make_session,
+    model_path,
+)
 from monopic.pose.warp import warp
 
 MIN_SCORE = 0.5
@@ -37,9 +43,14 @@ class PoseDetector:
     """Runs the detector on windows of a frame and returns detections in frame pixels."""
 
     def __init__(
-        self, threads: int = 1, min_score: float = MIN_SCORE, runtime: str = DEFAULT_RUNTIME
+        self,
+        threads: int = 1,
+        min_score: float = MIN_SCORE,
+        runtime: str = DEFAULT_RUNTIME,
+        model: str = DEFAULT_DETECTOR_MODEL,
     ) -> None:
-        self.session = make_session(model_path(DETECTOR_FILE), threads, runtime=runtime)
+        # Both detector models share inputs and outputs (monopic.pose.sessions).
+        self.session = make_session(model_path(detector_file(model)), threads, runtime=runtime)
         self.input_name = self.session.get_inputs()[0].name
         outputs = self.session.get_outputs()
         by_width = {o.shape[-1]: o.name for o in outputs}

@@ -12,14 +12,20 @@ from pathlib import Path
 
 import onnxruntime as ort
 
-DETECTOR_FILE = "pose_detection.onnx"
+# The person detector: MediaPipe's (converted by `make models`), or "int8", that model
+# quantised (`make models-int8`; its stem and feature pyramid kept float): 0.65 of the
+# float pass at one thread and 0.68 at two on an AVX-512 VNNI core, the tracker's found
+# frames and landmark error the same within the paired interval (issue 21; docs/
+# benchmarks.md, session 16).
+DETECTOR_MODELS = {"float": "pose_detection.onnx", "int8": "pose_detection_int8.onnx"}
+DEFAULT_DETECTOR_MODEL = "float"
 # MediaPipe's three landmark models (its model_complexity 0, 1, 2), all converted by
 # `make models` from MediaPipe's own files (monopic/pose/models/NOTICE.md says where each
 # comes from). Full is the one the paper and MediaPipe's Pose solution use by default.
 # full-int8 is the full model quantised (`make models-int8`; int8 weights and activations,
-# its stem and regression branch kept float): 0.74-0.82 of the full model's time at one
-# thread on an AVX-512 VNNI core, no faster at two; its landmark error equal to the full
-# model's within the paired interval (issue 21; docs/benchmarks.md, session 15).
+# its stem and regression branch kept float): 0.67 of the full model's time at one
+# thread on an AVX-512 VNNI core, 0.82 at two; its landmark error equal to the full
+# model's within the paired interval (issue 21; docs/benchmarks.md, sessions 15-16).
 LANDMARK_MODELS = {
     "lite": "pose_landmark_lite.onnx",
     "full": "pose_landmark_full.onnx",
@@ -32,11 +38,20 @@ LANDMARK_FILE = LANDMARK_MODELS[DEFAULT_LANDMARK_MODEL]
 
 def landmark_file(model: str) -> str:
     """The shipped file of landmark model `model` (lite, full, heavy or full-int8)."""
+    return _choice("landmark", LANDMARK_MODELS, model)
+
+
+def detector_file(model: str) -> str:
+    """The shipped file of detector model `model` (float or int8)."""
+    return _choice("detector", DETECTOR_MODELS, model)
+
+
+def _choice(kind: str, files: dict[str, str], model: str) -> str:
     try:
-        return LANDMARK_MODELS[model]
+        return files[model]
     except KeyError:
         raise ValueError(
-            f"unknown landmark model {model!r}: choose one of {', '.join(LANDMARK_MODELS)}"
+            f"unknown {kind} model {model!r}: choose one of {', '.join(files)}"
         ) from None
 
 

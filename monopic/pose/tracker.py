@@ -28,9 +28,11 @@ from monopic.pose.landmarks import LandmarkModel, Pose
 from monopic.pose.region import DEFAULT_SCALE, Region
 from monopic.pose.search import GroundBand, Window, search_windows
 from monopic.pose.sessions import (
+    DEFAULT_DETECTOR_MODEL,
     DEFAULT_LANDMARK_MODEL,
     DEFAULT_RUNTIME,
     check_runtime,
+    detector_file,
     landmark_file,
 )
 from monopic.pose.warp import four_channel
@@ -41,6 +43,9 @@ class TrackerConfig:
     threads: int = 1  # onnxruntime intra-op threads per model
     # MediaPipe's landmark model choice: "lite", "full" (its default) or "heavy".
     model: str = DEFAULT_LANDMARK_MODEL
+    # The person detector: "float" (MediaPipe's) or "int8" (quantised; faster passes
+    # while searching, monopic.pose.sessions.DETECTOR_MODELS).
+    detector: str = DEFAULT_DETECTOR_MODEL
     # onnxruntime's execution provider for both models (monopic.pose.sessions.RUNTIMES).
     runtime: str = DEFAULT_RUNTIME
     min_detection_score: float = 0.5
@@ -65,6 +70,7 @@ class TrackerConfig:
 
     def __post_init__(self) -> None:
         landmark_file(self.model)  # an unknown name fails here, with the choices
+        detector_file(self.detector)
         check_runtime(self.runtime)
         if self.search_budget < 0 or self.search_budget == 1 and self.acquire_tiles:
             raise ValueError(
@@ -93,7 +99,9 @@ class PoseTracker:
 
     def __post_init__(self) -> None:
         cfg = self.config
-        self.detector = PoseDetector(cfg.threads, cfg.min_detection_score, cfg.runtime)
+        self.detector = PoseDetector(
+            cfg.threads, cfg.min_detection_score, cfg.runtime, cfg.detector
+        )
         self.landmarks = LandmarkModel(cfg.threads, cfg.model, cfg.runtime)
         self._region: Region | None = None
         self._next_tile = 0  # where the search resumes in the tile cascade

@@ -332,3 +332,7 @@ def test_a_goal_names_a_runtime_or_landmark_model_that_is_not_the_default() -> N
     assert _runtime({}) == "" and _runtime({"runtime": "cpu", "model": "full"}) == ""
     assert _runtime({"runtime": "openvino"}) == " on openvino"
     assert _runtime({"model": "full-int8"}) == " with full-int8"
+    assert _runtime({"detector": "float"}) == ""
+    assert _runtime({"detector": "int8"}) == " with the int8 detector"
+    both = {"model": "full-int8", "detector": "int8"}
+    assert _runtime(both) == " with full-int8 and the int8 detector"

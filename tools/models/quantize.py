@@ -1,8 +1,9 @@
 """An int8 candidate of the landmark model or the detector, for bench/int8_*.py to judge.
 
-Static quantisation with onnxruntime's quantizer (QDQ format): weights int8 per output
-channel, activations uint8 per tensor, ranges calibrated on landmark-model crops of
-rendered frames and the shipped clip (written by `bench/int8_landmarks.py crops`). The
+Static quantisation with onnxruntime's quantizer (QDQ format; `--format qoperator` for
+its QLinear operators): weights int8 per output channel, activations uint8 per tensor,
+ranges calibrated on landmark-model crops of rendered frames and the shipped clip (written
+by `bench/int8_landmarks.py crops`; the detector's windows with --detector, below). The
 shipped float model stores its weights as fp16 + Cast, which the quantizer would take for
 activations; they are turned back into float32 initializers first (lossless). The result
 is NOT shipped unless the judge says it keeps the float model's landmark error (issue 21).
@@ -11,8 +12,8 @@ is NOT shipped unless the judge says it keeps the float model's landmark error (
         --out recordings/int8/pose_landmark_full_int8.onnx [--method minmax|percentile|entropy]
         [--deep-only PX] [--keep-outputs]
 
---keep-outputs keeps each output's nodes back to its last convolution in float (a uint8
-landmark output would step by about a pixel; session 12: it did not help).
+--keep-outputs keeps each output's nodes back to its last convolution (on every path) in
+float (a uint8 landmark output would step by about a pixel; session 12: it did not help).
 
 --deep-only PX quantizes only the convolutions whose output is at most PX pixels on a side
 (the deep, many-channel layers, where int8 kernels gain most), keeping the early
@@ -28,9 +29,10 @@ AVX-512 VNNI EPYC; `bench/int8_landmarks.py judge ... --rounds 6`: int8 - float 
         --equalize 1.5 --float-ends --gptq
 
 --float-ends keeps the stem (the first three convolutions, 128 px; no faster in int8) and
-the regression branch (every node that feeds only the landmark and flag outputs, not the
-heatmap: the 4 and 2 px blocks, their residual adds and the heads, 7 % of the MACs) in
-float. This is what matters: the uint8 residual tensors of those small blocks, which the
+the regression branch in float (`--float-ends stem` or `branch`: one of them; for the
+detector's, below). The branch is every node that feeds only the landmark and flag outputs,
+not the heatmap (the 4 and 2 px blocks, their residual adds and the heads, 7 % of the
+MACs). This is what matters: the uint8 residual tensors of those small blocks, which the
 regressed points (and so the heatmap window the refinement reads) come from, carried most
 of the landmark shift. Excluding their convolutions alone does not do it (their adds keep
 the tensors uint8), the whole branch must stay float. Alone, with min-max calibration, it
@@ -64,15 +66,44 @@ model's depthwise convolutions float that way: +0.45 [+0.19, +0.74] px and 1.12x
 time, no better than all int8.
 
 The detector (issue 17's search frames, issue 21's CPU-seconds), for
-bench/int8_detector.py to judge:
+bench/int8_detector.py to judge, calibrated on the letterboxed detector windows (uint8,
+scaled to [-1, 1] as the detector takes them) written by `bench/int8_detector.py windows`.
+Every option above applies to it (--equalize and --gptq run the detector's own feeds;
+--keep-heads keeps only its six output convolutions float). Its windows go through the
+calibrator in chunks (`_chunk`: it keeps every tensor of every input until the end, 34 GB
+for 600 windows). For the detector --float-ends keeps the stem (three convolutions, 112 px)
+and the feature pyramid float: every node the backbone's deepest tensor does not depend on
+(the top-down path from the first Resize, its lateral projections of the 28 and 14 px
+blocks, the six heads; 23 % of the MACs, the stem 4 %). The uint8 tensors there are what
+moved the detections (800 windows of the calibration frames that the calibration did not
+use): all int8 but the output tails, the regressed keypoints moved a median 0.8-2.7 px of
+the 224 px window, and decoding float scores with int8 boxes moved the detection as much
+as all int8, int8 scores with float boxes hardly at all; the heads float, still 0.4-1.4 px
+(their inputs uint8); the heads and the top-down path float, 0.1-0.5 px.
 
     .venv-models/bin/python tools/models/quantize.py --detector \
-        --crops recordings/int8/detector_windows.npz --out recordings/int8/pose_detection_int8.onnx
+        --crops recordings/int8/detector_windows.npz \
+        --out monopic/pose/models/pose_detection_int8.onnx \
+        --method percentile --equalize 1.5 --float-ends --gptq
 
-calibrated on the letterboxed detector windows (uint8, scaled to [-1, 1] as the detector
-takes them) written by `bench/int8_detector.py windows`; onnxruntime's QOperator format
-(QLinearConv), its depthwise convolutions kept in float (on an AVX2 CPU without VNNI, int8
-depthwise convolutions are slower than float ones).
+`bench/int8_detector.py judge ... --no-append` (600 frames x 27 windows, the AVX-512 VNNI
+EPYC, 2026-12-03, load 3 from another job, so the time ratio is the alternated one):
+tracker found 98.2 % of frames with either detector (differing on 0 frames); windows found
+by one detector only 42 float, 10 int8 (of 4635 float finds); the farthest keypoint moved
+a median 1.0 % of the float box's height (p95 3.0 %); the tracker's landmark error, int8
+detector - float, -0.02 [-0.18, +0.17] px on 559 frames; 0.69 of the float pass time at 1
+thread (9.13 vs 13.22 ms). With min-max calibration and neither --equalize nor --gptq
+(`--detector --float-ends`): 54 / 12 windows, 1.2 % (p95 3.8 %), -0.05 [-0.19, +0.09] px,
+0.66 (load 1.0). All int8 but the output tails (`--method percentile --equalize 1.5
+--gptq --keep-outputs`): 9 / 352 windows, the tracker 95.0 %, 7.5 % (p95 13.6 %), +0.38
+[+0.04, +0.80] px, 0.63. The first is shipped (session 16, `make models-int8`) as
+monopic/pose/models/pose_detection_int8.onnx, the tracker's `detector="int8"` choice;
+the default detector stays the float one.
+
+Session 9's detector (not shipped: the tracker found 68 % of frames against 98 %) was
+`--detector --format qoperator --float-depthwise` with min-max calibration (QLinearConv;
+on an AVX2 CPU without VNNI, int8 depthwise convolutions were slower than float ones);
+before session 16 --detector implied those two options.
 """
 
 from __future__ import annotations
@@ -388,38 +419,57 @@ def gptq_weights(
     return done
 
 
-def _regression_branch(model: onnx.ModelProto, detector: bool = False) -> list[str]:
-    """The nodes that feed the landmark and flag outputs but not the heatmap; of the
-    detector, the nodes that feed the box regressors but not the scores."""
+def _ancestors(model: onnx.ModelProto, tensor: str) -> set[str]:
+    """The names of the nodes `tensor` depends on (its producer included)."""
     producer = {o: n for n in model.graph.node for o in n.output}
+    seen: set[str] = set()
+    stack = [tensor]
+    while stack:
+        node = producer.get(stack.pop())
+        if node is not None and node.name not in seen:
+            seen.add(node.name)
+            stack.extend(node.input)
+    return seen
 
-    def ancestors(output: str) -> set[str]:
-        seen: set[str] = set()
-        stack = [output]
-        while stack:
-            node = producer.get(stack.pop())
-            if node is not None and node.name not in seen:
-                seen.add(node.name)
-                stack.extend(node.input)
-        return seen
 
+def _regression_branch(model: onnx.ModelProto) -> list[str]:
+    """The nodes that feed the landmark and flag outputs but not the heatmap."""
     names = [o.name for o in model.graph.output]
-    shared = "scores" if detector else "heatmap"
-    heatmap = [n for n in names if shared in n]
+    heatmap = [n for n in names if "heatmap" in n]
     if len(heatmap) != 1:
-        raise SystemExit(f"quantize: --float-ends expects one {shared} output, not {names}")
-    regression = set().union(*(ancestors(n) for n in names if n not in heatmap))
-    return [n.name for n in model.graph.node if n.name in regression - ancestors(heatmap[0])]
+        raise SystemExit(f"quantize: --float-ends expects one heatmap output, not {names}")
+    regression = set().union(*(_ancestors(model, n) for n in names if n not in heatmap))
+    shared = _ancestors(model, heatmap[0])
+    return [n.name for n in model.graph.node if n.name in regression - shared]
+
+
+def _pyramid(model: onnx.ModelProto) -> list[str]:
+    """The detector's nodes that the backbone's deepest tensor (the first Resize's input)
+    does not depend on: the feature pyramid's top-down path, its lateral projections of
+    the 28 and 14 px blocks, and the six heads with their reshapes."""
+    first = next((n for n in model.graph.node if n.op_type == "Resize"), None)
+    if first is None:
+        raise SystemExit("quantize: --float-ends expects the detector's Resize (its pyramid)")
+    backbone = _ancestors(model, first.input[0])
+    return [n.name for n in model.graph.node if n.name not in backbone]
 
 
 class Crops(CalibrationDataReader):
     """The calibration crops, one at a time, scaled as the model expects: u8 / 255 for the
-    landmark model (input `image`), u8 / 127.5 - 1 for the detector."""
+    landmark model (input `image`), u8 / 127.5 - 1 for the detector. `set_range` restricts
+    them to a slice (the quantizer's chunked calibration, `CalibStridedMinMax`)."""
 
     def __init__(self, crops: np.ndarray, name: str = "image", detector: bool = False) -> None:
+        self._crops = crops
         self._it = iter(crops)
         self._name = name
         self._detector = detector
+
+    def __len__(self) -> int:
+        return len(self._crops)
+
+    def set_range(self, start_index: int, end_index: int) -> None:
+        self._it = iter(self._crops[start_index:end_index])
 
     def get_next(self) -> dict[str, np.ndarray] | None:
         crop = next(self._it, None)
@@ -428,6 +478,14 @@ class Crops(CalibrationDataReader):
         x = crop.astype(np.float32)
         x = x / 127.5 - 1.0 if self._detector else x / 255.0
         return {self._name: x[None]}
+
+
+def _chunk(n: int, most: int = 50) -> int:
+    """The largest divisor of n up to `most`: the detector's calibration windows go through
+    the calibrator in chunks of this many. It keeps every tensor of every input it runs
+    until it computes the ranges (57 MB a detector window, 34 GB for 600); min-max ranges
+    merge exactly, percentile histograms extend their bins from chunk to chunk."""
+    return max(d for d in range(1, min(n, most) + 1) if n % d == 0)
 
 
 def main() -> int:
@@ -491,7 +549,7 @@ def main() -> int:
     if args.float_ends in ("stem", "both"):
         exclude += [n.name for n in convs[:3]]
     if args.float_ends in ("branch", "both"):
-        exclude += _regression_branch(model, args.detector)
+        exclude += _pyramid(model) if args.detector else _regression_branch(model)
     args.out.parent.mkdir(parents=True, exist_ok=True)
     with tempfile.TemporaryDirectory() as tmp:
         src = Path(tmp) / "float32.onnx"
@@ -506,6 +564,7 @@ def main() -> int:
             weight_type=QuantType.QInt8,
             calibrate_method=METHODS[args.method],
             nodes_to_exclude=exclude,
+            extra_options={"CalibStridedMinMax": _chunk(len(crops))} if args.detector else None,
         )
         if qdq:
             quantized = onnx.load(args.out)
