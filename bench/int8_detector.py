@@ -22,7 +22,9 @@ people in the same places. Three steps:
         1 thread
 
 `judge` appends one line to bench/history.jsonl unless --no-append. Nothing is shipped by
-this script: the shipped detector stays the float one unless a judged run says otherwise.
+this script. The judged int8 detector of session 16 ships as the tracker's `detector="int8"`
+choice (monopic/pose/models/pose_detection_int8.onnx, `make models-int8`); the default
+detector stays the float one.
 """
 
 from __future__ import annotations
