@@ -86,6 +86,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--threads", type=positive_int, default=1, help="onnxruntime threads (default %(default)d)"
     )
     p.add_argument(
+        "--spin",
+        action="store_true",
+        help="with --threads above 1, let onnxruntime's threads spin-wait within each model "
+        "run: faster on cores the pipeline has to itself, much slower on busy ones",
+    )
+    p.add_argument(
         "--model",
         choices=list(LANDMARK_MODELS),
         default=DEFAULT_LANDMARK_MODEL,
@@ -137,6 +143,8 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     if args.variant not in {v.value for v in Variant}:
         raise UserError(f"unknown variant {args.variant!r}")
+    if args.spin and args.threads < 2:
+        raise UserError(f"--spin needs --threads 2 or more (got --threads {args.threads})")
     source = VideoSource(args.input)
     ego = _ego(args, source.width, source.height)
     source.ego = ego
@@ -162,6 +170,7 @@ def run(args: argparse.Namespace) -> int:
             mode=mode,
             tracker=TrackerConfig(
                 threads=args.threads,
+                spin=args.spin,
                 model=args.model,
                 detector=args.detector,
                 runtime=args.runtime,

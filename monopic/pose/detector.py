@@ -48,9 +48,12 @@ class PoseDetector:
         min_score: float = MIN_SCORE,
         runtime: str = DEFAULT_RUNTIME,
         model: str = DEFAULT_DETECTOR_MODEL,
+        spin: bool = False,
     ) -> None:
         # Both detector models share inputs and outputs (monopic.pose.sessions).
-        self.session = make_session(model_path(detector_file(model)), threads, runtime=runtime)
+        self.session = make_session(
+            model_path(detector_file(model)), threads, spin=spin, runtime=runtime
+        )
         self.input_name = self.session.get_inputs()[0].name
         outputs = self.session.get_outputs()
         by_width = {o.shape[-1]: o.name for o in outputs}

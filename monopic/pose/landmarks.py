@@ -67,14 +67,18 @@ class Pose:
 
 class LandmarkModel:
     def __init__(
-        self, threads: int = 1, model: str = DEFAULT_LANDMARK_MODEL, runtime: str = DEFAULT_RUNTIME
+        self,
+        threads: int = 1,
+        model: str = DEFAULT_LANDMARK_MODEL,
+        runtime: str = DEFAULT_RUNTIME,
+        spin: bool = False,
     ) -> None:
         # The three models share inputs and outputs; only size and accuracy differ.
         self.model = model
         file = landmark_file(model)
-        # No spinning, even though it runs every frame: on a shared host spinning threads
-        # cost far more than they save (sessions.py).
-        self.session = make_session(model_path(file), threads, spin=False, runtime=runtime)
+        # Spinning only when asked: on a shared host it costs far more than it saves
+        # (sessions.make_session).
+        self.session = make_session(model_path(file), threads, spin=spin, runtime=runtime)
         self.input_name = self.session.get_inputs()[0].name
         # Outputs are told apart by shape: landmarks (1, 195), pose flag (1, 1), heatmap
         # (1, 39, 64, 64): channels first, as the converted files keep it (NOTICE.md).

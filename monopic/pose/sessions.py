@@ -133,13 +133,16 @@ def make_session(
 ) -> ort.InferenceSession:
     """A session using exactly `threads` intra-op threads, on `runtime` (RUNTIMES).
 
-    `spin` lets a multi-threaded session's idle threads spin-wait between runs. On a
-    quiet host that saved the landmark model 7 % at 2 threads (7.8 vs 8.3 ms per frame,
-    issue 7); on a loaded one it cost 1.6x (45 vs 27 ms, alternated, load average 11,
-    issue 21) and burns CPU time between frames, so no session spins by default. Never
-    for two sessions that take turns: each one's spinning threads then hold the cores
-    the other needs (the detector ran 2x slower right after a spinning landmark
-    session). One thread has no pool: nothing spins.
+    `spin` lets a multi-threaded session's idle threads spin-wait between the operators
+    of a run, and stops them when the run returns (onnxruntime's
+    session.force_spinning_stop), so nothing spins between frames or while the other
+    model runs. Waking a sleeping thread for each of a model's ~150 small operators costs
+    more than the operator: on a quiet AVX-512 host spinning took the int8 landmark model
+    from 5.41 to 4.31 ms at 2 threads, the float one from 7.51 to 5.82 and the detector
+    from 9.25 to 7.13, at the same CPU time (issue 21, docs/benchmarks.md session 17).
+    On a host whose cores are busy with other work it cost 1.6x (13.7 vs 8.6 ms with two
+    busy loops beside it), so no session spins by default: it is for a machine whose cores
+    are the pipeline's own. One thread has no pool: nothing spins.
 
     On "openvino" the thread count and float32 precision are OpenVINO's own settings:
     on a CPU with AMX it would otherwise compute in bfloat16, which moves landmarks.
@@ -152,8 +155,10 @@ def make_session(
     opts.inter_op_num_threads = 1
     opts.execution_mode = ort.ExecutionMode.ORT_SEQUENTIAL
     opts.graph_optimization_level = ort.GraphOptimizationLevel.ORT_ENABLE_ALL
-    spinning = "1" if spin and threads > 1 else "0"
-    opts.add_session_config_entry("session.intra_op.allow_spinning", spinning)
+    spinning = spin and threads > 1
+    opts.add_session_config_entry("session.intra_op.allow_spinning", "1" if spinning else "0")
+    if spinning:  # spin during a run only: stop when it returns
+        opts.add_session_config_entry("session.force_spinning_stop", "1")
     if threads > 1:  # smaller blocks, taken dynamically: a delayed thread does less
         opts.add_session_config_entry("session.dynamic_block_base", "4")
     opts.add_session_config_entry("session.inter_op.allow_spinning", "0")

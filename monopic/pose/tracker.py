@@ -41,6 +41,10 @@ from monopic.pose.warp import four_channel
 @dataclass(frozen=True)
 class TrackerConfig:
     threads: int = 1  # onnxruntime intra-op threads per model
+    # With threads > 1: the pool's threads spin-wait between a run's operators (stopping
+    # when it returns). About 0.8x the time on cores the pipeline has to itself, 1.6x on
+    # busy ones (monopic.pose.sessions.make_session), so off unless asked.
+    spin: bool = False
     # MediaPipe's landmark model choice: "lite", "full" (its default) or "heavy".
     model: str = DEFAULT_LANDMARK_MODEL
     # The person detector: "float" (MediaPipe's) or "int8" (quantised; faster passes
@@ -100,9 +104,9 @@ class PoseTracker:
     def __post_init__(self) -> None:
         cfg = self.config
         self.detector = PoseDetector(
-            cfg.threads, cfg.min_detection_score, cfg.runtime, cfg.detector
+            cfg.threads, cfg.min_detection_score, cfg.runtime, cfg.detector, cfg.spin
         )
-        self.landmarks = LandmarkModel(cfg.threads, cfg.model, cfg.runtime)
+        self.landmarks = LandmarkModel(cfg.threads, cfg.model, cfg.runtime, cfg.spin)
         self._region: Region | None = None
         self._next_tile = 0  # where the search resumes in the tile cascade
         self._filter = LandmarkFilter(self.config.smooth_landmarks, self.config.smooth_region)

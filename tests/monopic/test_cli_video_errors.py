@@ -31,6 +31,12 @@ def test_missing_input(tmp_path):
     assert len(r.stderr.strip().splitlines()) == 1
 
 
+def test_spin_without_threads_to_spin(tmp_path):
+    r = run("x.mp4", "--spin", cwd=tmp_path)
+    assert r.returncode == 2 and "--spin needs --threads 2 or more" in r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+
+
 def test_unknown_variant_and_bad_horizon(tmp_path):
     r = run("x.mp4", "--variant", "teleport", cwd=tmp_path)
     assert r.returncode == 2 and "teleport" in r.stderr

@@ -18,7 +18,7 @@ from monopic.pose.filtering import LandmarkFilter
 from monopic.pose.landmarks import LandmarkModel, Pose
 from monopic.pose.region import Region
 from monopic.pose.search import tile_windows
-from monopic.pose.sessions import runtime_unavailable
+from monopic.pose.sessions import LANDMARK_FILE, make_session, model_path, runtime_unavailable
 from monopic.pose.tracker import PoseTracker, TrackerConfig
 from monopic.video import VideoSource
 from tests.monopic.test_end_to_end import CLIP
@@ -298,6 +298,34 @@ def test_the_int8_detector_finds_the_walker_where_the_float_one_does():
         height = a[0].box[3] - a[0].box[1]
         assert 0.0 < np.abs(np.subtract(a[0].box, b[0].box)).max() < 0.05 * height
         assert np.abs(a[0].keypoints - b[0].keypoints).max() < 0.05 * height
+
+
+def test_spinning_threads_spin_within_runs_only_and_give_the_same_landmarks():
+    """`spin` (issue 21) lets a 2-thread pool spin-wait between operators and stops it
+    when a run returns; one thread has no pool to spin. Spinning changes when threads
+    wake, not what they compute: the tracked landmarks are the same bits."""
+
+    def entries(session) -> tuple[str | None, ...]:
+        opts, out = session.get_session_options(), []
+        for key in ("session.intra_op.allow_spinning", "session.force_spinning_stop"):
+            try:
+                out.append(opts.get_session_config_entry(key))
+            except RuntimeError:  # onnxruntime's answer for a key never set
+                out.append(None)
+        return tuple(out)
+
+    assert entries(make_session(model_path(LANDMARK_FILE), 2, spin=True)) == ("1", "1")
+    assert entries(make_session(model_path(LANDMARK_FILE), 2)) == ("0", None)
+    assert entries(make_session(model_path(LANDMARK_FILE), 1, spin=True)) == ("0", None)
+    spinning = PoseTracker(TrackerConfig(threads=2, spin=True))
+    assert entries(spinning.landmarks.session) == entries(spinning.detector.session)
+    sleeping = PoseTracker(TrackerConfig(threads=2))
+    for i, frame in enumerate(VideoSource(str(CLIP))):
+        if i == 5:
+            break
+        a = spinning.process(frame.image, timestamp=frame.timestamp).pose
+        b = sleeping.process(frame.image, timestamp=frame.timestamp).pose
+        assert np.array_equal(a.landmarks, b.landmarks)
 
 
 OPENVINO_UNAVAILABLE = runtime_unavailable("openvino")  # why not, asked once
