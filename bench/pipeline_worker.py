@@ -8,6 +8,7 @@ as shipped: the pruned landmark model and MediaPipe's heatmap refinement
 
     .venv/bin/python bench/pipeline_worker.py --frames recordings/bench/frames-*.npy --threads 1
         [--model lite|full|heavy|full-int8] [--detector float|int8] [--runtime cpu|openvino]
+        [--spin]
 """
 
 from __future__ import annotations
@@ -37,7 +38,11 @@ class OurRunner:
         self._frame = Frame
         self._extractor = FeatureExtractor
         config = TrackerConfig(
-            threads=args.threads, model=args.model, detector=args.detector, runtime=args.runtime
+            threads=args.threads,
+            model=args.model,
+            detector=args.detector,
+            runtime=args.runtime,
+            spin=args.spin,
         )
         self.pipeline = Pipeline(PipelineConfig(tracker=config))
 
@@ -68,6 +73,7 @@ def options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--model", choices=("lite", "full", "heavy", "full-int8"), default="full")
     ap.add_argument("--detector", choices=("float", "int8"), default="float")
     ap.add_argument("--runtime", choices=("cpu", "openvino"), default="cpu")
+    ap.add_argument("--spin", action="store_true", help="threads spin-wait within a run")
 
 
 def main() -> None:

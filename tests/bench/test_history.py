@@ -336,3 +336,24 @@ def test_a_goal_names_a_runtime_or_landmark_model_that_is_not_the_default() -> N
     assert _runtime({"detector": "int8"}) == " with the int8 detector"
     both = {"model": "full-int8", "detector": "int8"}
     assert _runtime(both) == " with full-int8 and the int8 detector"
+    assert _runtime({"spin": False}) == ""
+    assert _runtime({"model": "full-int8", "spin": True}) == " with full-int8, spinning threads"
+
+
+def test_the_cpu_goal_is_judged_on_every_frame_with_the_same_work_beside() -> None:
+    """The energy proxy counts every frame (our tile search too); the frames both sides
+    found are shown beside, never instead."""
+    from goals import cpu_ratio_at
+
+    results = comparison((6.0, 10.0), (5.0, 10.0), [])
+    for row, same in zip(results["cpu"], (4.0, 10.0, 4.5, 10.0), strict=True):
+        row["cpu_ms_per_both_found_frame"] = same
+    one = cpu_ratio_at(1)(results)
+    assert one is not None and not one.met
+    assert one.measured.startswith("0.60 (6.0 vs 10.0 CPU-ms per frame; 0.40 on frames both found)")
+    two = cpu_ratio_at(2)(results)
+    assert two is not None and two.met and "; 0.45 on frames both found" in two.measured
+    for row in results["cpu"]:
+        row["cpu_ms_per_both_found_frame"] = None  # an older run, or no frame both found
+    old = cpu_ratio_at(1)(results)
+    assert old is not None and old.measured == "0.60 (6.0 vs 10.0 CPU-ms per frame)"
