@@ -58,6 +58,9 @@ _COLUMN_PAIRS = {
 }
 
 
+_FOOT_INDEX = np.array(FOOT_LANDMARKS)
+
+
 def foot_point(
     pose: Pose, image_height: int, column: GroundColumn = GroundColumn.FEET
 ) -> tuple[float, float]:
@@ -68,7 +71,7 @@ def foot_point(
     landmark box under its centre. With `column` hips or shoulders, the column is that
     pair's midpoint when both are visible (else as above).
     """
-    idx = [i for i in FOOT_LANDMARKS if pose.visibility[i] >= MIN_FOOT_VISIBILITY]
+    idx = _FOOT_INDEX[pose.visibility[_FOOT_INDEX] >= MIN_FOOT_VISIBILITY]
     pts = pose.landmarks[idx, :2]
     if len(idx) >= 2 and np.all(pts[:, 1] < image_height):
         u, v = float(pts[:, 0].mean()), float(pts[:, 1].max())

@@ -27,7 +27,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monopic.features.window import SlidingWindow
+from monopic.features.window import SlidingWindow, median
 from monopic.pose.skeleton import INDEX, LEFT_SHOULDER, RIGHT_SHOULDER
 
 LEFT_EYE, RIGHT_EYE = INDEX["left_eye"], INDEX["right_eye"]
@@ -125,16 +125,14 @@ class HeadTurnWindow:
         """Add this frame's facing (NaN: not seen) and return the turn toward the camera."""
         if math.isfinite(facing):
             self._facings.add(timestamp, abs(facing))
-        t, v, _ = self._facings.arrays()
-        if not len(t):
-            return float("nan")
-        v = v[:, 0]
-        now = v[t >= timestamp - self.now_s - 1e-9]
+        samples = self._facings.first_values()  # Python floats: a few samples, no numpy
+        start = timestamp - self.now_s - 1e-9
         far, near = timestamp - self.past_s[1] - 1e-9, timestamp - self.past_s[0] + 1e-9
-        past = v[(t >= far) & (t <= near)]
-        if len(now) < self.min_now or len(past) < self.min_past:
-            return float("nan")
-        return float(np.median(past) - np.median(now))
+        now = [v for t, v in samples if t >= start]
+        past = [v for t, v in samples if far <= t <= near]
+        if len(now) < max(self.min_now, 1) or len(past) < max(self.min_past, 1):
+            return float("nan")  # (an empty median was NaN)
+        return median(past) - median(now)
 
     def reset(self) -> None:
         self._facings.reset()
