@@ -84,6 +84,7 @@ def run_worker(
     runtime: str = "cpu",
     detector: str = "float",
     spin: bool = False,
+    search: str = "tiles",
 ) -> Run:
     cmd, extra_env = worker_command(side, ref_python)
     cmd += ["--frames", str(frames), "--threads", str(threads), "--warmup", str(warmup)]
@@ -91,7 +92,8 @@ def run_worker(
     # quantisation of its full model.
     cmd += ["--model", model if side == OURS else model.removesuffix("-int8")]
     if side == OURS:  # the reference runs MediaPipe's own (float) detector
-        cmd += ["--runtime", runtime, "--detector", detector] + ["--spin"] * spin
+        cmd += ["--runtime", runtime, "--detector", detector, "--search", search]
+        cmd += ["--spin"] * spin
     if pin:
         cmd.append("--pin")
     env = dict(os.environ, **extra_env)
@@ -410,6 +412,13 @@ def main() -> None:
         "pthreadpool does before it sleeps "
         "(monopic.pose.sessions.make_session)",
     )
+    ap.add_argument(
+        "--search",
+        choices=("tiles", "whole-frame"),
+        default="tiles",
+        help="our side's search while no one is tracked: the tile cascade that finds far "
+        "pedestrians (default), or the whole frame only, as the reference searches",
+    )
     ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
     from monopic.pose.sessions import runtime_unavailable
@@ -440,6 +449,7 @@ def main() -> None:
                     runtime=args.runtime,
                     detector=args.detector,
                     spin=args.spin,
+                    search=args.search,
                 )
                 loads += [run.load_before, run.load_after]
                 col.runs.append(run)
@@ -465,6 +475,7 @@ def main() -> None:
         "model": args.model,
         "detector": args.detector,
         "spin": args.spin,
+        "search": args.search,
         "load_min": min(loads),
         "load_max": max(loads),
         "latency": [],
@@ -492,7 +503,8 @@ def main() -> None:
         f"{n} frames 768x432 in {len(fs.sequences)} sequences ({seqs}); "
         f"sides {', '.join(sides)} (ours on onnxruntime's {args.runtime} execution provider, "
         f"landmark model {args.model}, {args.detector} detector"
-        f"{', threads spinning within runs' if args.spin else ''}); "
+        f"{', threads spinning within runs' if args.spin else ''}"
+        f"{', searching the whole frame only' if args.search == 'whole-frame' else ''}); "
         f"{args.rounds} ABBA rounds per thread count, {args.warmup} warm-up frames per run; "
         f"workers pinned to N cores: {not args.no_pin}; "
         f"load average during the runs {min(loads):.1f}-{max(loads):.1f} on "

@@ -68,7 +68,8 @@ def _runtime(results: dict[str, Any]) -> str:
     """' on openvino' for a run whose pose models were not on the default runtime, ' with
     full-int8' for one whose landmark model was not the default full one, ' and the int8
     detector' (or ' with the int8 detector') for one whose detector was not the float one,
-    and ', spinning threads' when our onnxruntime threads spin-waited within runs."""
+    ', spinning threads' when our onnxruntime threads spin-waited within runs, and ',
+    whole-frame search' when ours searched as the reference does (no tiles)."""
     runtime, model = results.get("runtime", "cpu"), results.get("model", "full")
     detector = results.get("detector", "float")
     text = ("" if runtime == "cpu" else f" on {runtime}") + (
@@ -78,6 +79,8 @@ def _runtime(results: dict[str, Any]) -> str:
         text += f" {'and' if model != 'full' else 'with'} the {detector} detector"
     if results.get("spin"):
         text += ", spinning threads"
+    if results.get("search", "tiles") != "tiles":
+        text += ", whole-frame search"
     return text
 
 

@@ -8,7 +8,7 @@ as shipped: the pruned landmark model and MediaPipe's heatmap refinement
 
     .venv/bin/python bench/pipeline_worker.py --frames recordings/bench/frames-*.npy --threads 1
         [--model lite|full|heavy|full-int8] [--detector float|int8] [--runtime cpu|openvino]
-        [--spin]
+        [--spin] [--search tiles|whole-frame]
 """
 
 from __future__ import annotations
@@ -43,6 +43,8 @@ class OurRunner:
             detector=args.detector,
             runtime=args.runtime,
             spin=args.spin,
+            # MediaPipe's search: the whole frame only, no tiles for far pedestrians.
+            **({"acquire_tiles": (), "far_tiles": ()} if args.search == "whole-frame" else {}),
         )
         self.pipeline = Pipeline(PipelineConfig(tracker=config))
 
@@ -74,6 +76,13 @@ def options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--detector", choices=("float", "int8"), default="float")
     ap.add_argument("--runtime", choices=("cpu", "openvino"), default="cpu")
     ap.add_argument("--spin", action="store_true", help="threads spin-wait within a run")
+    ap.add_argument(
+        "--search",
+        choices=("tiles", "whole-frame"),
+        default="tiles",
+        help="while no one is tracked: the tile cascade (ours) or the whole frame only "
+        "(MediaPipe's way)",
+    )
 
 
 def main() -> None:

@@ -338,6 +338,8 @@ def test_a_goal_names_a_runtime_or_landmark_model_that_is_not_the_default() -> N
     assert _runtime(both) == " with full-int8 and the int8 detector"
     assert _runtime({"spin": False}) == ""
     assert _runtime({"model": "full-int8", "spin": True}) == " with full-int8, spinning threads"
+    assert _runtime({"search": "tiles"}) == ""
+    assert _runtime({"search": "whole-frame"}) == ", whole-frame search"
 
 
 def test_the_cpu_goal_is_judged_on_every_frame_with_the_same_work_beside() -> None:
