@@ -136,13 +136,12 @@ def make_session(
     `spin` lets a multi-threaded session's idle threads spin-wait between the operators
     of a run, and stops them when the run returns (onnxruntime's
     session.force_spinning_stop), so nothing spins between frames or while the other
-    model runs. Waking a sleeping thread for each of a model's ~150 small operators costs
-    more than the operator: on a quiet AVX-512 host spinning took the int8 landmark model
-    from 5.41 to 4.31 ms at 2 threads, the float one from 7.51 to 5.82 and the detector
-    from 9.25 to 7.13, at the same CPU time (issue 21, docs/benchmarks.md session 17).
-    On a host whose cores are busy with other work it cost 1.6x (13.7 vs 8.6 ms with two
-    busy loops beside it), so no session spins by default: it is for a machine whose cores
-    are the pipeline's own. One thread has no pool: nothing spins.
+    model runs. Waking a sleeping thread for each of a model's ~160 small operators costs
+    more than the operator: on a quiet AVX-512 host spinning took each pose model 0.82-0.84
+    of its time at 2 threads, at about the same CPU time (bench/spin.py, issue 21,
+    docs/benchmarks.md session 17). Beside other work on the cores it took twice the
+    time (`bench/spin.py --busy 2`), so no session spins by default: it is for a machine
+    whose cores are the pipeline's own. One thread has no pool: nothing spins.
 
     On "openvino" the thread count and float32 precision are OpenVINO's own settings:
     on a CPU with AMX it would otherwise compute in bfloat16, which moves landmarks.

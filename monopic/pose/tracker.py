@@ -42,7 +42,7 @@ from monopic.pose.warp import four_channel
 class TrackerConfig:
     threads: int = 1  # onnxruntime intra-op threads per model
     # With threads > 1: the pool's threads spin-wait between a run's operators (stopping
-    # when it returns). About 0.8x the time on cores the pipeline has to itself, 1.6x on
+    # when it returns). About 0.8x the time on cores the pipeline has to itself, 2x on
     # busy ones (monopic.pose.sessions.make_session), so off unless asked.
     spin: bool = False
     # MediaPipe's landmark model choice: "lite", "full" (its default) or "heavy".
