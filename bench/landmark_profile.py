@@ -176,7 +176,9 @@ def variants(full: Path, threads: int, candidates: list[Path], work: Path) -> di
     """Sessions to alternate: shipped, spinning, no NCHWc, ORT format, and the candidates."""
     out: dict[str, Any] = {"shipped": make_session(full, threads, spin=False)}
     if threads > 1:
-        out["spinning intra-op threads"] = make_session(full, threads, spin=True)
+        # Since session 17 they spin within a run only (TrackerConfig.spin); older lines
+        # of the history under "spinning intra-op threads" also spun between runs.
+        out["threads spinning within runs"] = make_session(full, threads, spin=True)
     ext = ort.SessionOptions()
     ext.intra_op_num_threads = threads
     ext.inter_op_num_threads = 1
