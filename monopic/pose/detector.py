@@ -10,10 +10,13 @@ detector can also run on windows of the frame (monopic.pose.search).
 
 from __future__ import annotations
 
+import weakref
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import cv2
 import numpy as np
+from onnxruntime import InferenceSession
 
 from monopic.pose.anchors import INPUT_SIZE, ssd_anchor_centres
 from monopic.pose.search import Window
@@ -51,9 +54,18 @@ class PoseDetector:
         spin: bool = False,
     ) -> None:
         # Both detector models share inputs and outputs (monopic.pose.sessions).
-        self.session = make_session(
-            model_path(detector_file(model)), threads, spin=spin, runtime=runtime
-        )
+        path = model_path(detector_file(model))
+        self.session = make_session(path, threads, spin=spin, runtime=runtime)
+        # A frame's tiles are independent passes: with more than one thread, they run side
+        # by side, one single-threaded pass per thread (onnxruntime runs a session from
+        # several threads at once, each on its caller's thread), rather than one after
+        # another with each pass split across the threads, which scales poorly on the
+        # detector's small maps. The same outputs bit for bit (test). CPU runtime only.
+        self._tiles: ThreadPoolExecutor | None = None
+        if threads > 1 and runtime == "cpu":
+            self._tile_session = make_session(path, 1, runtime=runtime)
+            self._tiles = ThreadPoolExecutor(threads, thread_name_prefix="tiles")
+            weakref.finalize(self, self._tiles.shutdown, wait=False)
         self.input_name = self.session.get_inputs()[0].name
         outputs = self.session.get_outputs()
         by_width = {o.shape[-1]: o.name for o in outputs}
@@ -65,14 +77,21 @@ class PoseDetector:
         """All detections, best first, after weighted NMS across every window."""
         h, w = image.shape[:2]
         windows = windows or [Window(0, 0, w, h)]
-        found: list[Detection] = []
-        for win in windows:
-            found.extend(self._detect_window(image, win))
+        if len(windows) > 1 and self._tiles is not None:
+            session = self._tile_session
+            per_window = list(
+                self._tiles.map(lambda w: self._detect_window(image, w, session), windows)
+            )
+        else:
+            per_window = [self._detect_window(image, win, self.session) for win in windows]
+        found = [det for dets in per_window for det in dets]  # in window order, as before
         return weighted_nms(found, NMS_IOU)
 
-    def _detect_window(self, image: np.ndarray, win: Window) -> list[Detection]:
+    def _detect_window(
+        self, image: np.ndarray, win: Window, session: InferenceSession
+    ) -> list[Detection]:
         tensor, to_frame = letterbox(image, win, INPUT_SIZE)
-        raw_boxes, raw_scores = self.session.run(
+        raw_boxes, raw_scores = session.run(
             [self.regressor_name, self.score_name], {self.input_name: tensor[None]}
         )
         boxes = raw_boxes.reshape(-1, 12)

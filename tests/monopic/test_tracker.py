@@ -328,6 +328,23 @@ def test_spinning_threads_spin_within_runs_only_and_give_the_same_landmarks():
         assert np.array_equal(a.landmarks, b.landmarks)
 
 
+def test_tiles_run_side_by_side_with_two_threads_and_find_the_same():
+    """With threads > 1 a frame's tiles run in parallel, one single-threaded pass each
+    (issue 21): the same detections, bit for bit, as one after another on one thread."""
+    frame = small_person_frame()
+    windows = tile_windows(768, 432, 216)
+    one, two = PoseDetector(threads=1), PoseDetector(threads=2, spin=True)
+    assert one._tiles is None and two._tiles is not None
+    a, b = one.detect(frame, windows), two.detect(frame, windows)
+    assert len(a) >= 1 and len(a) == len(b)
+    for x, y in zip(a, b, strict=True):
+        assert x.score == y.score and x.box == y.box
+        assert np.array_equal(x.keypoints, y.keypoints)
+    tracked = [PoseTracker(TrackerConfig(threads=t, search_budget=0)) for t in (1, 2)]
+    poses = [t.process(frame).pose for t in tracked]
+    assert poses[0] is not None and np.array_equal(poses[0].landmarks, poses[1].landmarks)
+
+
 OPENVINO_UNAVAILABLE = runtime_unavailable("openvino")  # why not, asked once
 
 
