@@ -11,7 +11,8 @@ detector can also run on windows of the frame (monopic.pose.search).
 from __future__ import annotations
 
 import weakref
-from concurrent.futures import ThreadPoolExecutor
+from collections.abc import Callable
+from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 
 import cv2
@@ -56,11 +57,12 @@ class PoseDetector:
         # Both detector models share inputs and outputs (monopic.pose.sessions).
         path = model_path(detector_file(model))
         self.session = make_session(path, threads, spin=spin, runtime=runtime)
-        # A frame's tiles are independent passes: with more than one thread, they run side
+        # A frame's windows are independent passes: with more than one thread they run side
         # by side, one single-threaded pass per thread (onnxruntime runs a session from
         # several threads at once, each on its caller's thread), rather than one after
         # another with each pass split across the threads, which scales poorly on the
         # detector's small maps. The same outputs bit for bit (test). CPU runtime only.
+        self._threads = threads
         self._tiles: ThreadPoolExecutor | None = None
         if threads > 1 and runtime == "cpu":
             self._tile_session = make_session(path, 1, runtime=runtime)
@@ -86,6 +88,57 @@ class PoseDetector:
             per_window = [self._detect_window(image, win, self.session) for win in windows]
         found = [det for dets in per_window for det in dets]  # in window order, as before
         return weighted_nms(found, NMS_IOU)
+
+    def detect_first(
+        self,
+        image: np.ndarray,
+        batches: list[list[Window]],
+        accept: Callable[[list[Detection]], bool] = bool,
+    ) -> tuple[list[Detection], int]:
+        """The detections of the first batch of windows whose detections (weighted NMS
+        within the batch, as `detect`) `accept` takes (by default: any), or none; and the
+        detector passes spent.
+
+        One thread: batch after batch, stopping at the first that finds someone. More:
+        the windows go in order to one single-threaded pass per thread, so the next
+        batch's first windows run beside the current batch (the whole frame beside the
+        first tile); when a batch finds someone, the passes already running are waited
+        for and counted, and no more start. The detections are the same either way; only
+        the passes spent (at most threads - 1 more) and the time differ.
+        """
+        if self._tiles is None or len(batches) < 2:
+            runs = 0
+            for windows in batches:
+                runs += len(windows)
+                dets = self.detect(image, windows)
+                if dets and accept(dets):
+                    return dets, runs
+            return [], runs
+        windows = [(b, win) for b, batch in enumerate(batches) for win in batch]
+        results: list[list[Detection] | None] = [None] * len(windows)
+        running: dict[Future, int] = {}
+        queued = 0  # windows handed to the passes so far
+
+        def top_up(end: int) -> None:  # one pass per thread, in window order, up to `end`
+            nonlocal queued
+            while queued < min(end, len(windows)) and len(running) < self._threads:
+                win = windows[queued][1]
+                job = self._tiles.submit(self._detect_window, image, win, self._tile_session)
+                running[job] = queued
+                queued += 1
+
+        for b in range(len(batches)):
+            members = [k for k, (bb, _) in enumerate(windows) if bb == b]
+            while any(results[k] is None for k in members):
+                top_up(members[-1] + self._threads)  # at most threads - 1 windows ahead
+                done, _ = wait(running, return_when=FIRST_COMPLETED)
+                for job in done:
+                    results[running.pop(job)] = job.result()
+            dets = weighted_nms([d for k in members for d in results[k] or []], NMS_IOU)
+            if dets and accept(dets):
+                wait(running)  # let no pass run on beside the landmark model
+                return dets, queued
+        return [], queued
 
     def _detect_window(
         self, image: np.ndarray, win: Window, session: InferenceSession

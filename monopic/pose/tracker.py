@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monopic.pose.detector import PoseDetector
+from monopic.pose.detector import Detection, PoseDetector
 from monopic.pose.filtering import LandmarkFilter
 from monopic.pose.landmarks import LandmarkModel, Pose
 from monopic.pose.region import DEFAULT_SCALE, Region
@@ -174,16 +174,15 @@ class PoseTracker:
             take = min(cfg.search_budget - 1, len(tiles))
             batches.append([tiles[(start + k) % len(tiles)] for k in range(take)])
             self._next_tile = (start + take) % len(tiles)
-        runs = 0
-        for windows in batches:
-            runs += len(windows)
-            dets = self.detector.detect(image, windows)
-            if dets:
-                best = dets[0]
-                region = Region.from_keypoints(
-                    tuple(best.keypoints[0]), tuple(best.keypoints[1]), cfg.region_scale
-                )
-                if region.valid:
-                    self._next_tile = 0
-                    return region, runs
-        return None, runs
+
+        def region_of(dets: list[Detection]) -> Region:
+            mid_hip, scale = dets[0].keypoints[0], dets[0].keypoints[1]
+            return Region.from_keypoints(tuple(mid_hip), tuple(scale), cfg.region_scale)
+
+        # The first batch whose best detection gives a valid region; a batch whose best
+        # does not is passed over, as if it had found no one.
+        dets, runs = self.detector.detect_first(image, batches, lambda d: region_of(d).valid)
+        if not dets:
+            return None, runs
+        self._next_tile = 0
+        return region_of(dets), runs

@@ -117,6 +117,9 @@ class ScriptedLandmarks:
 
 
 class ScriptedDetector:
+    _tiles = None  # one thread: the real detector's batch-by-batch search over `detect`
+    detect_first = PoseDetector.detect_first
+
     def __init__(self, *args) -> None:
         self.finds: list[bool] = []  # per detect() call: somebody there or not
 
@@ -343,6 +346,24 @@ def test_tiles_run_side_by_side_with_two_threads_and_find_the_same():
     tracked = [PoseTracker(TrackerConfig(threads=t, search_budget=0)) for t in (1, 2)]
     poses = [t.process(frame).pose for t in tracked]
     assert poses[0] is not None and np.array_equal(poses[0].landmarks, poses[1].landmarks)
+
+
+def test_the_budgeted_search_finds_the_same_with_two_threads_spending_a_pass_ahead():
+    """With two threads the next batch's first window runs beside the current batch (the
+    whole frame beside the first tile): the same frames found, the same landmarks and
+    the same place in the cascade; the passes spent count the one run ahead."""
+    small, near = small_person_frame(), next(iter(VideoSource(str(CLIP)))).image
+    frames = [small] * 6 + [IMAGE] * 2 + [near]  # search, track, lose, find near at once
+    one, two = (PoseTracker(TrackerConfig(threads=t)) for t in (1, 2))
+    for k, image in enumerate(frames):
+        a, b = one.process(image), two.process(image)
+        assert a.found == b.found, k
+        if a.found:
+            assert np.array_equal(a.pose.landmarks, b.pose.landmarks), k
+        assert one._next_tile == two._next_tile, k
+        if a.detector_runs:  # the batches one thread ran, and at most one pass ahead
+            assert a.detector_runs <= b.detector_runs <= a.detector_runs + 1, k
+    assert a.found and a.detector_runs == 1 and b.detector_runs == 2  # near: whole frame
 
 
 OPENVINO_UNAVAILABLE = runtime_unavailable("openvino")  # why not, asked once
