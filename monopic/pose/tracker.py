@@ -40,7 +40,9 @@ from monopic.pose.warp import four_channel
 
 @dataclass(frozen=True)
 class TrackerConfig:
-    threads: int = 1  # onnxruntime intra-op threads per model
+    # onnxruntime intra-op threads per model; while searching, also the number of detector
+    # windows run side by side (monopic.pose.detector.PoseDetector.detect_first).
+    threads: int = 1
     # With threads > 1: the pool's threads spin-wait between a run's operators (stopping
     # when it returns). About 0.8x the time on cores the pipeline has to itself, 2x on
     # busy ones (monopic.pose.sessions.make_session), so off unless asked.
