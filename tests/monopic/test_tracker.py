@@ -366,6 +366,26 @@ def test_the_budgeted_search_finds_the_same_with_two_threads_spending_a_pass_ahe
     assert a.found and a.detector_runs == 1 and b.detector_runs == 2  # near: whole frame
 
 
+class PointDetector(ScriptedDetector):
+    """The whole frame finds a 'person' whose two keypoints coincide (no region); the
+    tiles find a real one."""
+
+    def detect(self, image: np.ndarray, windows=None) -> list[Detection]:
+        whole = len(windows) == 1 and windows[0].width == image.shape[1]
+        kps = np.array([[350.0, 200.0], [350.0, 200.0 if whole else 140.0]] + [[350.0, 150.0]] * 2)
+        return [Detection(0.9, (300.0, 100.0, 400.0, 300.0), kps)]
+
+
+def test_a_batch_whose_best_detection_gives_no_region_is_passed_over(monkeypatch):
+    monkeypatch.setattr(tracker_module, "LandmarkModel", ScriptedLandmarks)
+    monkeypatch.setattr(tracker_module, "PoseDetector", PointDetector)
+    tracker = PoseTracker(TrackerConfig())
+    tracker.landmarks.script = [scripted_pose(0)]
+    result = tracker.process(IMAGE)
+    assert result.found and result.detector_runs == 4  # the whole frame, then 3 tiles
+    assert [r.side > 100.0 for r in tracker.landmarks.regions] == [True]  # the tiles' 60 px
+
+
 OPENVINO_UNAVAILABLE = runtime_unavailable("openvino")  # why not, asked once
 
 
