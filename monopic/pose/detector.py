@@ -76,17 +76,11 @@ class PoseDetector:
         self.min_score = min_score
 
     def detect(self, image: np.ndarray, windows: list[Window] | None = None) -> list[Detection]:
-        """All detections, best first, after weighted NMS across every window."""
+        """All detections, best first, after weighted NMS across every window, one window
+        after another (`detect_first` runs windows side by side)."""
         h, w = image.shape[:2]
         windows = windows or [Window(0, 0, w, h)]
-        if len(windows) > 1 and self._tiles is not None:
-            session = self._tile_session
-            per_window = list(
-                self._tiles.map(lambda w: self._detect_window(image, w, session), windows)
-            )
-        else:
-            per_window = [self._detect_window(image, win, self.session) for win in windows]
-        found = [det for dets in per_window for det in dets]  # in window order, as before
+        found = [det for win in windows for det in self._detect_window(image, win, self.session)]
         return weighted_nms(found, NMS_IOU)
 
     def detect_first(
@@ -106,15 +100,15 @@ class PoseDetector:
         for and counted, and no more start. The detections are the same either way; only
         the passes spent (at most threads - 1 more) and the time differ.
         """
-        if self._tiles is None or len(batches) < 2:
+        windows = [(b, win) for b, batch in enumerate(batches) for win in batch]
+        if self._tiles is None or len(windows) < 2:
             runs = 0
-            for windows in batches:
-                runs += len(windows)
-                dets = self.detect(image, windows)
+            for batch in batches:
+                runs += len(batch)
+                dets = self.detect(image, batch)
                 if dets and accept(dets):
                     return dets, runs
             return [], runs
-        windows = [(b, win) for b, batch in enumerate(batches) for win in batch]
         results: list[list[Detection] | None] = [None] * len(windows)
         running: dict[Future, int] = {}
         queued = 0  # windows handed to the passes so far

@@ -338,8 +338,8 @@ def test_tiles_run_side_by_side_with_two_threads_and_find_the_same():
     windows = tile_windows(768, 432, 216)
     one, two = PoseDetector(threads=1), PoseDetector(threads=2, spin=True)
     assert one._tiles is None and two._tiles is not None
-    a, b = one.detect(frame, windows), two.detect(frame, windows)
-    assert len(a) >= 1 and len(a) == len(b)
+    (a, runs_a), (b, runs_b) = (d.detect_first(frame, [windows]) for d in (one, two))
+    assert len(a) >= 1 and len(a) == len(b) and runs_a == runs_b == len(windows)
     for x, y in zip(a, b, strict=True):
         assert x.score == y.score and x.box == y.box
         assert np.array_equal(x.keypoints, y.keypoints)
