@@ -1,4 +1,5 @@
-"""Where the detector looks while searching: the ground band and the tiles that cover it."""
+"""Where the detector looks while searching: the ground band, the tiles that cover it, and
+the order a searching frame tries its windows in (zooms on faint candidates included)."""
 
 import math
 
@@ -7,12 +8,18 @@ from hypothesis import given
 from hypothesis import strategies as st
 
 from monopic.camera import CameraModel
+from monopic.pose.region import Region
 from monopic.pose.search import (
+    MAX_ZOOMS,
     PERSON_HEIGHTS_M,
+    Faint,
     GroundBand,
+    SearchSteps,
+    Window,
     band_windows,
     search_windows,
     tile_windows,
+    zoom_window,
 )
 
 
@@ -71,3 +78,63 @@ def test_search_with_band_is_narrower_and_adds_far_tiles():
     far = levels[-1]
     top, bottom = band.rows(48.0)
     assert all(w.width == 96 and w.y <= top and w.y + 96 >= bottom for w in far)
+
+
+WHOLE = Window(0, 0, 768, 432)
+TILES = [Window(float(k), 0, 216, 216) for k in range(6)]
+
+
+def faint(score: float, x: float = 300.0) -> Faint:
+    return Faint(score, Region(x, 200.0, 60.0))
+
+
+def tried(steps: SearchSteps, learnt: dict[int, Faint] | None = None) -> list[Window]:
+    """Every window `steps` gives, telling it `learnt[k]` after the k-th."""
+    out = []
+    while (win := steps.next()) is not None:
+        steps.learn((learnt or {}).get(len(out)))
+        out.append(win)
+    return out
+
+
+def test_a_search_tries_the_whole_frame_then_the_cascade_from_where_it_stopped():
+    steps = SearchSteps(WHOLE, TILES, start=4, budget=4)
+    assert tried(steps) == [WHOLE, TILES[4], TILES[5], TILES[0]]
+    assert steps.next_tile == 1 and steps.carry is None
+    assert tried(SearchSteps(WHOLE, TILES, start=0, budget=0)) == [WHOLE, *TILES]
+    assert tried(SearchSteps(WHOLE, [], start=0, budget=4)) == [WHOLE]
+
+
+def test_a_faint_candidate_is_zoomed_on_next_within_the_budget():
+    steps = SearchSteps(WHOLE, TILES, start=0, budget=4)
+    windows = tried(steps, {0: faint(0.2)})
+    assert windows == [WHOLE, zoom_window(faint(0.2).region), TILES[0], TILES[1]]
+    assert windows[1] == Window(252.0, 152.0, 96.0, 96.0)  # the region, at least 96 px
+    assert steps.next_tile == 2  # the zoom took a tile's place, not its turn
+
+
+def test_a_zoom_is_followed_only_by_a_stronger_candidate():
+    weaker = tried(SearchSteps(WHOLE, TILES, 0, 0), {0: faint(0.2), 1: faint(0.15, 500.0)})
+    assert weaker[2] == TILES[0]  # the zoom's weaker candidate is background: dropped
+    stronger = tried(SearchSteps(WHOLE, TILES, 0, 0), {0: faint(0.2), 1: faint(0.3, 500.0)})
+    assert stronger[2] == zoom_window(faint(0.3, 500.0).region)
+
+
+def test_zooms_are_bounded_and_what_is_left_carries_to_the_next_frame():
+    learnt = {k: faint(0.1 + 0.05 * k, 100.0 * k) for k in range(7)}
+    windows = tried(SearchSteps(WHOLE, TILES, 0, 0), learnt)
+    zooms = [w for w in windows if w not in TILES and w != WHOLE]
+    assert len(zooms) == MAX_ZOOMS and len(windows) == 1 + MAX_ZOOMS + len(TILES)
+    steps = SearchSteps(WHOLE, TILES, 0, budget=2)
+    assert tried(steps, {1: faint(0.3)}) == [WHOLE, TILES[0]]  # no pass left to zoom
+    assert steps.carry == faint(0.3)
+    again = SearchSteps(WHOLE, TILES, steps.next_tile, budget=3, carried=steps.carry)
+    assert tried(again) == [WHOLE, zoom_window(faint(0.3).region), TILES[1]]
+
+
+def test_upcoming_windows_are_what_next_gives_when_nothing_is_learnt():
+    steps = SearchSteps(WHOLE, TILES, 0, budget=4)
+    assert steps.next() == WHOLE
+    assert steps.upcoming(2) == [TILES[0], TILES[1]]
+    steps.learn(faint(0.2))
+    assert steps.upcoming(5) == [zoom_window(faint(0.2).region), TILES[0], TILES[1]]
