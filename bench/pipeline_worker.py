@@ -43,8 +43,12 @@ class OurRunner:
             detector=args.detector,
             runtime=args.runtime,
             spin=args.spin,
-            # MediaPipe's search: the whole frame only, no tiles for far pedestrians.
-            **({"acquire_tiles": (), "far_tiles": ()} if args.search == "whole-frame" else {}),
+            # MediaPipe's search: the whole frame only, no tiles nor zooms for far pedestrians.
+            **(
+                {"acquire_tiles": (), "far_tiles": (), "zoom_score": None}
+                if args.search == "whole-frame"
+                else {}
+            ),
         )
         self.pipeline = Pipeline(PipelineConfig(tracker=config))
 

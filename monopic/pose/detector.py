@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import weakref
 from collections.abc import Callable
-from concurrent.futures import FIRST_COMPLETED, Future, ThreadPoolExecutor, wait
+from concurrent.futures import Future, ThreadPoolExecutor, wait
 from dataclasses import dataclass
 
 import cv2
@@ -20,7 +20,8 @@ import numpy as np
 from onnxruntime import InferenceSession
 
 from monopic.pose.anchors import INPUT_SIZE, ssd_anchor_centres
-from monopic.pose.search import Window
+from monopic.pose.region import DEFAULT_SCALE, Region
+from monopic.pose.search import Faint, SearchSteps, Window
 from monopic.pose.sessions import (
     DEFAULT_DETECTOR_MODEL,
     DEFAULT_RUNTIME,
@@ -53,6 +54,8 @@ class PoseDetector:
         runtime: str = DEFAULT_RUNTIME,
         model: str = DEFAULT_DETECTOR_MODEL,
         spin: bool = False,
+        zoom_score: float | None = None,
+        region_scale: float = DEFAULT_SCALE,
     ) -> None:
         # Both detector models share inputs and outputs (monopic.pose.sessions).
         path = model_path(detector_file(model))
@@ -74,69 +77,79 @@ class PoseDetector:
         self.regressor_name, self.score_name = by_width[12], by_width[1]
         self.anchors = ssd_anchor_centres()
         self.min_score = min_score
+        # A window with no detection reports its best anchor scoring at least this (and
+        # the region its keypoints give, at region_scale); None reports none.
+        self.zoom_score = zoom_score
+        self.region_scale = region_scale
 
     def detect(self, image: np.ndarray, windows: list[Window] | None = None) -> list[Detection]:
         """All detections, best first, after weighted NMS across every window, one window
         after another (`detect_first` runs windows side by side)."""
         h, w = image.shape[:2]
         windows = windows or [Window(0, 0, w, h)]
-        found = [det for win in windows for det in self._detect_window(image, win, self.session)]
+        found = [det for win in windows for det in self._look(image, win, self.session)[0]]
         return weighted_nms(found, NMS_IOU)
 
     def detect_first(
         self,
         image: np.ndarray,
-        batches: list[list[Window]],
+        steps: SearchSteps,
         accept: Callable[[list[Detection]], bool] = bool,
     ) -> tuple[list[Detection], int]:
-        """The detections of the first batch of windows whose detections (weighted NMS
-        within the batch, as `detect`) `accept` takes (by default: any), or none; and the
-        detector passes spent.
+        """The detections (weighted NMS within the window) of the first window `steps`
+        gives whose detections `accept` takes (by default: any), or none; and the detector
+        passes spent. Each window that finds no one tells `steps` its faint candidate.
 
-        One thread: batch after batch, stopping at the first that finds someone. More:
-        the windows go in order to one single-threaded pass per thread, so the next
-        batch's first windows run beside the current batch (the whole frame beside the
-        first tile); when a batch finds someone, the passes already running are waited
-        for and counted, and no more start. The detections are the same either way; only
-        the passes spent (at most threads - 1 more) and the time differ.
+        One thread: window after window. More: one single-threaded pass per thread, the
+        windows `steps` would give next running beside the current one (the whole frame
+        beside the first tile); results are read in `steps`' order, so the detections and
+        what `steps` learns are the same either way; only the passes spent (at most
+        threads - 1 more) and the time differ.
         """
-        windows = [(b, win) for b, batch in enumerate(batches) for win in batch]
-        if self._tiles is None or len(windows) < 2:
+        if self._tiles is None:
             runs = 0
-            for batch in batches:
-                runs += len(batch)
-                dets = self.detect(image, batch)
+            while (win := steps.next()) is not None:
+                runs += 1
+                dets, faint = self.look(image, win)
                 if dets and accept(dets):
                     return dets, runs
+                steps.learn(faint)
             return [], runs
-        results: list[list[Detection] | None] = [None] * len(windows)
-        running: dict[Future, int] = {}
-        queued = 0  # windows handed to the passes so far
+        running: dict[Window, Future] = {}
+        runs = 0
 
-        def top_up(end: int) -> None:  # one pass per thread, in window order, up to `end`
-            nonlocal queued
-            while queued < min(end, len(windows)) and len(running) < self._threads:
-                win = windows[queued][1]
-                job = self._tiles.submit(self._detect_window, image, win, self._tile_session)
-                running[job] = queued
-                queued += 1
+        def start(win: Window) -> None:
+            nonlocal runs
+            if win not in running:
+                running[win] = self._tiles.submit(self._look, image, win, self._tile_session)
+                runs += 1
 
-        for b in range(len(batches)):
-            members = [k for k, (bb, _) in enumerate(windows) if bb == b]
-            while any(results[k] is None for k in members):
-                top_up(members[-1] + self._threads)  # at most threads - 1 windows ahead
-                done, _ = wait(running, return_when=FIRST_COMPLETED)
-                for job in done:
-                    results[running.pop(job)] = job.result()
-            dets = weighted_nms([d for k in members for d in results[k] or []], NMS_IOU)
-            if dets and accept(dets):
-                wait(running)  # let no pass run on beside the landmark model
-                return dets, queued
-        return [], queued
+        try:
+            while (win := steps.next()) is not None:
+                start(win)
+                for ahead in steps.upcoming(self._threads):
+                    if len(running) >= self._threads:
+                        break
+                    start(ahead)
+                raw, faint = running.pop(win).result()
+                dets = weighted_nms(raw, NMS_IOU)
+                if dets and accept(dets):
+                    return dets, runs
+                steps.learn(faint)
+            return [], runs
+        finally:
+            wait(running.values())  # let no pass run on beside the landmark model
 
-    def _detect_window(
+    def look(self, image: np.ndarray, win: Window) -> tuple[list[Detection], Faint | None]:
+        """One detector pass on `win`: its detections after weighted NMS, and, when there
+        are none, its best anchor if that reaches the zoom's threshold (a faint candidate)."""
+        raw, faint = self._look(image, win, self.session)
+        return weighted_nms(raw, NMS_IOU), faint
+
+    def _look(
         self, image: np.ndarray, win: Window, session: InferenceSession
-    ) -> list[Detection]:
+    ) -> tuple[list[Detection], Faint | None]:
+        """The window's detections before NMS, and its faint candidate when it has none."""
         tensor, to_frame = letterbox(image, win, INPUT_SIZE)
         raw_boxes, raw_scores = session.run(
             [self.regressor_name, self.score_name], {self.input_name: tensor[None]}
@@ -145,21 +158,27 @@ class PoseDetector:
         logits = np.clip(raw_scores.reshape(-1).astype(np.float64), -100.0, 100.0)
         scores = 1.0 / (1.0 + np.exp(-logits))
         keep = np.flatnonzero(scores >= self.min_score)
-        out = []
-        for i in keep:
-            ax, ay = self.anchors[i]
-            r = boxes[i] / INPUT_SIZE
-            cx, cy, bw, bh = r[0] + ax, r[1] + ay, r[2], r[3]
-            kps = r[4:12].reshape(4, 2) + (ax, ay)
-            corners = to_frame(np.array([[cx - bw / 2, cy - bh / 2], [cx + bw / 2, cy + bh / 2]]))
-            out.append(
-                Detection(
-                    score=float(scores[i]),
-                    box=(corners[0, 0], corners[0, 1], corners[1, 0], corners[1, 1]),
-                    keypoints=to_frame(kps),
-                )
-            )
-        return out
+        dets = [self._decode(boxes[i], float(scores[i]), i, to_frame) for i in keep]
+        if dets or self.zoom_score is None:
+            return dets, None
+        best = int(np.argmax(scores))
+        if scores[best] < self.zoom_score:
+            return [], None
+        kps = self._decode(boxes[best], float(scores[best]), best, to_frame).keypoints
+        region = Region.from_keypoints(tuple(kps[0]), tuple(kps[1]), self.region_scale)
+        return [], Faint(float(scores[best]), region) if region.valid else None
+
+    def _decode(self, box: np.ndarray, score: float, anchor: int, to_frame) -> Detection:
+        ax, ay = self.anchors[anchor]
+        r = box / INPUT_SIZE
+        cx, cy, bw, bh = r[0] + ax, r[1] + ay, r[2], r[3]
+        kps = r[4:12].reshape(4, 2) + (ax, ay)
+        corners = to_frame(np.array([[cx - bw / 2, cy - bh / 2], [cx + bw / 2, cy + bh / 2]]))
+        return Detection(
+            score=score,
+            box=(corners[0, 0], corners[0, 1], corners[1, 0], corners[1, 1]),
+            keypoints=to_frame(kps),
+        )
 
 
 def letterbox(image: np.ndarray, win: Window, size: int):

@@ -1,13 +1,15 @@
 """One-pedestrian tracker wired like MediaPipe's pose solution.
 
 Acquire: run the detector on the whole frame, then on square tiles of decreasing size
-until someone is found (far pedestrians are too small for the whole frame squeezed into
-224 px; monopic.pose.search says which tiles, fewer and smaller ones when the camera's
-ground band is known); keep the most confident detection. Each tile costs a detector
-pass (the 27 tiles of a 768x432 frame took about 380 ms on one core), so a frame spends
-at most `search_budget` passes: the whole frame every time (near pedestrians are found at
-once) and the next tiles of the cascade, which resumes where the previous frame stopped.
-Track: crop the rotated region, run the
+until a window finds someone (far pedestrians are too small for the whole frame squeezed
+into 224 px; monopic.pose.search says which tiles, fewer and smaller ones when the
+camera's ground band is known); keep that window's most confident detection. A window
+that finds no one but half-sees someone (a faint candidate) is followed by a zoom on that
+candidate's region. Each window costs a detector pass (the 27 tiles of a 768x432 frame
+took about 380 ms on one core), so a frame spends at most `search_budget` passes: the
+whole frame every time (near pedestrians are found at once), zooms, and the next tiles
+of the cascade, which resumes where the previous frame stopped. Track: crop the rotated
+region, run the
 landmark model, take the next frame's region from this frame's auxiliary points. When the
 pose flag drops, the person is lost and the detector runs again (in the same frame).
 Filter: given frame timestamps, landmarks, visibility and the auxiliary points are smoothed
@@ -26,7 +28,7 @@ from monopic.pose.detector import Detection, PoseDetector
 from monopic.pose.filtering import LandmarkFilter
 from monopic.pose.landmarks import LandmarkModel, Pose
 from monopic.pose.region import DEFAULT_SCALE, Region
-from monopic.pose.search import GroundBand, Window, search_windows
+from monopic.pose.search import Faint, GroundBand, SearchSteps, Window, search_windows
 from monopic.pose.sessions import (
     DEFAULT_DETECTOR_MODEL,
     DEFAULT_LANDMARK_MODEL,
@@ -62,11 +64,17 @@ class TrackerConfig:
     # Upscaled tiles for far pedestrians, tried only inside the camera's ground band.
     far_tiles: tuple[int, ...] = (96,)
     tile_overlap: float = 0.25
-    # Detector passes per frame while searching: the whole frame + (budget - 1) tiles of
-    # the cascade. 0 runs the whole cascade in every frame (offline, no time limit). 4
-    # passes (about 55 ms on one core) keep a searching frame within a 15 fps frame
-    # period; 6 found far pedestrians 2 frames sooner on average (BENCHMARKS.md).
+    # Detector passes per frame while searching: the whole frame, zooms and tiles of the
+    # cascade, one window at a time until one finds someone. 0 runs the whole cascade in
+    # every frame (offline, no time limit). 4 passes (about 50 ms on one core) keep a
+    # searching frame within a 15 fps frame period.
     search_budget: int = 4
+    # A window that finds no one but whose best anchor scores at least this (below
+    # min_detection_score) is followed by a zoom on that candidate's own region
+    # (monopic.pose.search.SearchSteps); None: no zooms. 0.1 was chosen on the validation
+    # frames (bench/frameset.py --recipe search): background windows reach it in 0.2 % of
+    # passes (0.07: 13.5 %), windows holding a person the detector misses in 18 %.
+    zoom_score: float | None = 0.1
     # With frame timestamps: smooth landmarks and visibility across frames (MediaPipe
     # Pose's smooth_landmarks, on by default there too).
     smooth_landmarks: bool = True
@@ -78,6 +86,11 @@ class TrackerConfig:
         landmark_file(self.model)  # an unknown name fails here, with the choices
         detector_file(self.detector)
         check_runtime(self.runtime)
+        if self.zoom_score is not None and not 0 < self.zoom_score < self.min_detection_score:
+            raise ValueError(
+                f"zoom_score must be None or between 0 and min_detection_score "
+                f"({self.min_detection_score}), got {self.zoom_score}"
+            )
         if self.search_budget < 0 or self.search_budget == 1 and self.acquire_tiles:
             raise ValueError(
                 f"search_budget must be 0 (no limit) or >= 2 when tiles are used, "
@@ -106,17 +119,25 @@ class PoseTracker:
     def __post_init__(self) -> None:
         cfg = self.config
         self.detector = PoseDetector(
-            cfg.threads, cfg.min_detection_score, cfg.runtime, cfg.detector, cfg.spin
+            cfg.threads,
+            cfg.min_detection_score,
+            cfg.runtime,
+            cfg.detector,
+            cfg.spin,
+            cfg.zoom_score,
+            cfg.region_scale,
         )
         self.landmarks = LandmarkModel(cfg.threads, cfg.model, cfg.runtime, cfg.spin)
         self._region: Region | None = None
         self._next_tile = 0  # where the search resumes in the tile cascade
+        self._faint: Faint | None = None  # a faint candidate the last search left to zoom on
         self._filter = LandmarkFilter(self.config.smooth_landmarks, self.config.smooth_region)
 
     def reset(self) -> None:
         """Forget the tracked person (e.g. at a cut in the video)."""
         self._region = None
         self._next_tile = 0
+        self._faint = None
         self._filter.reset()
 
     def process(
@@ -168,23 +189,19 @@ class PoseTracker:
         cfg = self.config
         levels = search_windows(w, h, cfg.acquire_tiles, cfg.far_tiles, cfg.tile_overlap, band)
         tiles = [win for level in levels for win in level]
-        batches: list[list[Window]] = [[Window(0, 0, w, h)]]
-        if cfg.search_budget == 0:
-            batches += levels  # coarse to fine, stop at the first level that finds someone
-        elif tiles:
-            start = self._next_tile % len(tiles)
-            take = min(cfg.search_budget - 1, len(tiles))
-            batches.append([tiles[(start + k) % len(tiles)] for k in range(take)])
-            self._next_tile = (start + take) % len(tiles)
+        steps = SearchSteps(
+            Window(0, 0, w, h), tiles, self._next_tile, cfg.search_budget, self._faint
+        )
 
         def region_of(dets: list[Detection]) -> Region:
             mid_hip, scale = dets[0].keypoints[0], dets[0].keypoints[1]
             return Region.from_keypoints(tuple(mid_hip), tuple(scale), cfg.region_scale)
 
-        # The first batch whose best detection gives a valid region; a batch whose best
+        # The first window whose best detection gives a valid region; a window whose best
         # does not is passed over, as if it had found no one.
-        dets, runs = self.detector.detect_first(image, batches, lambda d: region_of(d).valid)
+        dets, runs = self.detector.detect_first(image, steps, lambda d: region_of(d).valid)
         if not dets:
+            self._next_tile, self._faint = steps.next_tile, steps.carry
             return None, runs
-        self._next_tile = 0
+        self._next_tile, self._faint = 0, None
         return region_of(dets), runs

@@ -57,13 +57,16 @@ def make_pipeline(
     too, last, so the primary predictor and the others' outputs are unchanged. `tracker`
     replaces the default one-thread tracker (the benchmarks time other runtimes with it).
 
-    The ablation's tracker never detects (a threshold above any score, and no tiles so a
-    failed crop costs one whole-frame pass): it only ever sees the true crop, so what it
+    The ablation's tracker never detects (a threshold above any score, and no tiles nor
+    zooms, so a failed crop costs one whole-frame pass): it only ever sees the true crop, so what it
     gets right or wrong is the pose from that crop.
     """
     if ablation:
         tracker = replace(
-            tracker or TrackerConfig(threads=1), min_detection_score=1.01, acquire_tiles=()
+            tracker or TrackerConfig(threads=1),
+            min_detection_score=1.01,
+            acquire_tiles=(),
+            zoom_score=None,
         )
     predictors = [make_predictor(name, mode) for name, mode in PREDICTORS]
     if intent_tree is not None:

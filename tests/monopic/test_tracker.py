@@ -17,7 +17,7 @@ from monopic.pose.detector import Detection, PoseDetector
 from monopic.pose.filtering import LandmarkFilter
 from monopic.pose.landmarks import LandmarkModel, Pose
 from monopic.pose.region import Region
-from monopic.pose.search import tile_windows
+from monopic.pose.search import SearchSteps, Window, tile_windows
 from monopic.pose.sessions import LANDMARK_FILE, make_session, model_path, runtime_unavailable
 from monopic.pose.tracker import PoseTracker, TrackerConfig
 from monopic.video import VideoSource
@@ -42,15 +42,29 @@ def tiles_in_cascade(config: TrackerConfig, width: int = 768, height: int = 432)
 
 @pytest.mark.slow
 def test_unlimited_search_finds_the_small_person_in_the_first_frame():
-    tracker = PoseTracker(TrackerConfig(search_budget=0))
+    tracker = PoseTracker(TrackerConfig(search_budget=0, zoom_score=None))
     first = tracker.process(small_person_frame())
     assert first.found
-    assert first.detector_runs > 4  # the whole frame missed it; the tiles found it
+    assert first.detector_runs > 4  # the whole frame and the 432 px tiles missed it
+
+
+@pytest.mark.slow
+def test_a_zoom_on_a_faint_candidate_finds_the_small_person_at_once():
+    """The whole frame sees nothing; a 432 px tile half-sees the 45 px walker (below the
+    detector's threshold, above the zoom's), and the zoom on that candidate's region
+    finds them in the first frame, where the cascade alone needs seven frames."""
+    frame = small_person_frame()
+    zooming = PoseTracker(TrackerConfig(search_budget=4))
+    first = zooming.process(frame)
+    assert first.found and first.detector_runs == 4  # whole frame, 2 tiles, the zoom
+    cascade = PoseTracker(TrackerConfig(search_budget=4, zoom_score=None))
+    results = [cascade.process(frame) for _ in range(8)]
+    assert next(k for k, r in enumerate(results) if r.found) == 6
 
 
 @pytest.mark.slow
 def test_budgeted_search_spreads_the_cascade_over_frames_and_then_tracks():
-    config = TrackerConfig(search_budget=4)
+    config = TrackerConfig(search_budget=4, zoom_score=None)
     tracker = PoseTracker(config)
     frame = small_person_frame()
     results = [tracker.process(frame) for _ in range(12)]
@@ -66,6 +80,12 @@ def test_search_budget_must_leave_room_for_a_tile():
         TrackerConfig(search_budget=1)
     with pytest.raises(ValueError, match="search_budget"):
         TrackerConfig(search_budget=-2)
+
+
+@pytest.mark.parametrize("score", [0.0, 0.5, 0.9])
+def test_the_zoom_threshold_must_lie_below_the_detectors(score: float):
+    with pytest.raises(ValueError, match="zoom_score must be None or between 0 and"):
+        TrackerConfig(zoom_score=score)
 
 
 @pytest.mark.slow
@@ -117,8 +137,11 @@ class ScriptedLandmarks:
 
 
 class ScriptedDetector:
-    _tiles = None  # one thread: the real detector's batch-by-batch search over `detect`
+    _tiles = None  # one thread: the real detector's window-by-window search over `look`
     detect_first = PoseDetector.detect_first
+
+    def look(self, image: np.ndarray, win) -> tuple[list[Detection], None]:
+        return self.detect(image, [win]), None
 
     def __init__(self, *args) -> None:
         self.finds: list[bool] = []  # per detect() call: somebody there or not
@@ -335,11 +358,13 @@ def test_tiles_run_side_by_side_with_two_threads_and_find_the_same():
     """With threads > 1 a frame's tiles run in parallel, one single-threaded pass each
     (issue 21): the same detections, bit for bit, as one after another on one thread."""
     frame = small_person_frame()
-    windows = tile_windows(768, 432, 216)
+    tiles = tile_windows(768, 432, 216)
     one, two = PoseDetector(threads=1), PoseDetector(threads=2, spin=True)
     assert one._tiles is None and two._tiles is not None
-    (a, runs_a), (b, runs_b) = (d.detect_first(frame, [windows]) for d in (one, two))
-    assert len(a) >= 1 and len(a) == len(b) and runs_a == runs_b == len(windows)
+    (a, runs_a), (b, runs_b) = (
+        d.detect_first(frame, SearchSteps(Window(0, 0, 768, 432), tiles, 0, 0)) for d in (one, two)
+    )
+    assert len(a) >= 1 and len(a) == len(b) and runs_a <= runs_b <= runs_a + 1
     for x, y in zip(a, b, strict=True):
         assert x.score == y.score and x.box == y.box
         assert np.array_equal(x.keypoints, y.keypoints)
@@ -382,7 +407,7 @@ def test_a_batch_whose_best_detection_gives_no_region_is_passed_over(monkeypatch
     tracker = PoseTracker(TrackerConfig())
     tracker.landmarks.script = [scripted_pose(0)]
     result = tracker.process(IMAGE)
-    assert result.found and result.detector_runs == 4  # the whole frame, then 3 tiles
+    assert result.found and result.detector_runs == 2  # the whole frame, then the first tile
     assert [r.side > 100.0 for r in tracker.landmarks.regions] == [True]  # the tiles' 60 px
 
 
