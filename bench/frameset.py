@@ -67,7 +67,18 @@ LARGE = Recipe("large", cases=tuple(range(1, 10)), distances=(3.0, 5.0, 8.0), fr
 CALIBRATION = Recipe(
     "calibration", cases=tuple(range(1, 9)), distances=(4.0, 7.0), frames=10, seed=2, clip_frames=30
 )
-RECIPES = {r.name: r for r in (DEFAULT, LARGE, CALIBRATION)}
+# Nine cases at six distances out to 12.5 m, 10 frames each, other seeds: the set the
+# search's faint-candidate zoom (monopic.pose.search.SearchSteps) was tuned on, so that
+# the comparison's frames never chose it.
+SEARCH = Recipe(
+    "search",
+    cases=tuple(range(1, 10)),
+    distances=(4.0, 6.5, 8.0, 9.5, 11.0, 12.5),
+    frames=10,
+    seed=3,
+    clip_frames=10,
+)
+RECIPES = {r.name: r for r in (DEFAULT, LARGE, CALIBRATION, SEARCH)}
 
 
 @dataclass(frozen=True)
