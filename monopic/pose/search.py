@@ -103,7 +103,7 @@ def search_windows(
     overlap: float,
     band: GroundBand | None,
 ) -> list[list[Window]]:
-    """The tile cascade after the whole frame, one list per tile size, coarse to fine.
+    """The tile cascade after the whole frame, one list per tile size, in `tiles` order.
 
     Without a band every tile size covers the whole frame and `far_tiles` are left out
     (a frame of 96 px tiles is 66 passes); with one, each size covers only its band.

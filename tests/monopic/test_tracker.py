@@ -52,12 +52,14 @@ def test_unlimited_search_finds_the_small_person_in_the_first_frame():
 def test_a_zoom_on_a_faint_candidate_finds_the_small_person_at_once():
     """The whole frame sees nothing; a 432 px tile half-sees the 45 px walker (below the
     detector's threshold, above the zoom's), and the zoom on that candidate's region
-    finds them in the first frame, where the cascade alone needs seven frames."""
+    finds them in the first frame, where the cascade alone needs seven frames. (The 432 px
+    tiles first, as before session 18, to see the zoom at work on this frame.)"""
     frame = small_person_frame()
-    zooming = PoseTracker(TrackerConfig(search_budget=4))
+    tiles = (432, 288, 216)
+    zooming = PoseTracker(TrackerConfig(search_budget=4, acquire_tiles=tiles))
     first = zooming.process(frame)
     assert first.found and first.detector_runs == 4  # whole frame, 2 tiles, the zoom
-    cascade = PoseTracker(TrackerConfig(search_budget=4, zoom_score=None))
+    cascade = PoseTracker(TrackerConfig(search_budget=4, zoom_score=None, acquire_tiles=tiles))
     results = [cascade.process(frame) for _ in range(8)]
     assert next(k for k, r in enumerate(results) if r.found) == 6
 
