@@ -43,6 +43,11 @@ class Detection:
     box: tuple[float, float, float, float]  # xmin, ymin, xmax, ymax
     keypoints: np.ndarray  # (4, 2): mid-hip, full-body scale, mid-shoulder, upper-body scale
 
+    def region(self, scale: float = DEFAULT_SCALE) -> Region:
+        """The landmark model's crop for this person, from the mid-hip and full-body
+        scale keypoints (as Pose.next_region does from the auxiliary points)."""
+        return Region.from_keypoints(tuple(self.keypoints[0]), tuple(self.keypoints[1]), scale)
+
 
 class PoseDetector:
     """Runs the detector on windows of a frame and returns detections in frame pixels."""
@@ -164,8 +169,9 @@ class PoseDetector:
         best = int(np.argmax(scores))
         if scores[best] < self.zoom_score:
             return [], None
-        kps = self._decode(boxes[best], float(scores[best]), best, to_frame).keypoints
-        region = Region.from_keypoints(tuple(kps[0]), tuple(kps[1]), self.region_scale)
+        region = self._decode(boxes[best], float(scores[best]), best, to_frame).region(
+            self.region_scale
+        )
         return [], Faint(float(scores[best]), region) if region.valid else None
 
     def _decode(self, box: np.ndarray, score: float, anchor: int, to_frame) -> Detection:

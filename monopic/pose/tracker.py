@@ -24,7 +24,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from monopic.pose.detector import Detection, PoseDetector
+from monopic.pose.detector import PoseDetector
 from monopic.pose.filtering import LandmarkFilter
 from monopic.pose.landmarks import LandmarkModel, Pose
 from monopic.pose.region import DEFAULT_SCALE, Region
@@ -198,15 +198,13 @@ class PoseTracker:
             Window(0, 0, w, h), tiles, self._next_tile, cfg.search_budget, self._faint
         )
 
-        def region_of(dets: list[Detection]) -> Region:
-            mid_hip, scale = dets[0].keypoints[0], dets[0].keypoints[1]
-            return Region.from_keypoints(tuple(mid_hip), tuple(scale), cfg.region_scale)
-
         # The first window whose best detection gives a valid region; a window whose best
         # does not is passed over, as if it had found no one.
-        dets, runs = self.detector.detect_first(image, steps, lambda d: region_of(d).valid)
+        dets, runs = self.detector.detect_first(
+            image, steps, lambda d: d[0].region(cfg.region_scale).valid
+        )
         if not dets:
             self._next_tile, self._faint = steps.next_tile, steps.carry
             return None, runs
         self._next_tile, self._faint = 0, None
-        return region_of(dets), runs
+        return dets[0].region(cfg.region_scale), runs
