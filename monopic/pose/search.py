@@ -154,8 +154,9 @@ class SearchSteps:
     whole frame or a coarse tile barely sees is then found in its own region, in one
     pass, instead of at the cascade's turn for their tile size (on the validation frames,
     bench/frameset.py's `search` recipe, with the 432 px tiles first: 36 % fewer passes,
-    found 0.5 frames sooner on average). A zoom's own faint candidate is followed only if it scores higher than the
-    one that led there, so a patch of background the detector half-likes costs one pass.
+    found 0.5 frames sooner on average). A zoom's own faint candidate is followed only if
+    it scores higher than the one that led there, so a patch of background the detector
+    half-likes costs one pass.
     `budget` windows at most (0: the whole cascade once); at most MAX_ZOOMS zooms.
     """
 
