@@ -41,8 +41,19 @@ CLOSED_LOOP_FILES = (
     "scenarios/families/small/cpna25.toml",
     "scenarios/families/small/nearmiss_kerb_stop.toml",
 )
-# Keys that hold the code, measured times or the machine, never a result.
-VOLATILE_KEYS = {"code", "timing", "wall_s", "seconds", "machine", "host", "created", "date"}
+# Keys that hold the code, measured times or the machine, never a result. A dataset run's
+# "bytes" counts its features CSV, whose timing columns change width from run to run.
+VOLATILE_KEYS = {
+    "code",
+    "timing",
+    "wall_s",
+    "seconds",
+    "machine",
+    "host",
+    "created",
+    "date",
+    "bytes",
+}
 # Lines of text outputs that carry times, machines or the code digest.
 VOLATILE_LINE = re.compile(r"Ran on:|ran on|code [0-9a-f]{12}|\bms\b|seconds|[0-9.]+ s\b", re.I)
 
@@ -149,7 +160,10 @@ def pixels(path: Path) -> str:
 
 def csv_rows(path: Path) -> list[dict[str, str]]:
     rows = list(csv.DictReader(io.StringIO(path.read_text())))
-    return [{k: v for k, v in r.items() if not (k or "").endswith("Ms")} for r in rows]
+    return [
+        {k: v for k, v in r.items() if not (k or "").endswith("Ms") and k not in VOLATILE_KEYS}
+        for r in rows
+    ]
 
 
 RENAMED: list[tuple[str, str]] = []  # (old, new) module names, from --renamed
