@@ -54,6 +54,13 @@ VOLATILE_KEYS = {
     "date",
     "bytes",
 }
+
+
+def volatile(key: str | None) -> bool:
+    """A key or column that holds the code, a measured time or the machine."""
+    return key in VOLATILE_KEYS or key == "ms" or (key or "").endswith("Ms")
+
+
 # Lines of text outputs that carry times, machines or the code digest.
 VOLATILE_LINE = re.compile(r"Ran on:|ran on|code [0-9a-f]{12}|\bms\b|seconds|[0-9.]+ s\b", re.I)
 
@@ -94,11 +101,7 @@ def capture(out: Path) -> None:
 def scrub(value: Any) -> Any:
     """The value without volatile keys (recursively)."""
     if isinstance(value, dict):
-        return {
-            k: scrub(v)
-            for k, v in value.items()
-            if k not in VOLATILE_KEYS and not k.endswith("Ms") and k != "ms"
-        }
+        return {k: scrub(v) for k, v in value.items() if not volatile(k)}
     if isinstance(value, list):
         return [scrub(v) for v in value]
     return value
@@ -160,10 +163,7 @@ def pixels(path: Path) -> str:
 
 def csv_rows(path: Path) -> list[dict[str, str]]:
     rows = list(csv.DictReader(io.StringIO(path.read_text())))
-    return [
-        {k: v for k, v in r.items() if not (k or "").endswith("Ms") and k not in VOLATILE_KEYS}
-        for r in rows
-    ]
+    return [{k: v for k, v in r.items() if not volatile(k)} for r in rows]
 
 
 RENAMED: list[tuple[str, str]] = []  # (old, new) module names, from --renamed
