@@ -17,6 +17,7 @@ constant second derivative, is the same wherever it is read.
 
 from __future__ import annotations
 
+import functools
 import math
 from collections import deque
 from collections.abc import Sequence
@@ -116,17 +117,21 @@ def derivatives_at(
     """
     tau = np.asarray(t, dtype=float) - float(at)
     y = np.asarray(values, dtype=float).reshape(len(tau), -1)
-    w = np.ones_like(tau) if weights is None else np.asarray(weights, dtype=float)
     if len(tau) <= degree:
         raise ValueError(f"a degree-{degree} fit needs more than {degree} samples")
     A = np.vander(tau, degree + 1, increasing=True)
     if weights is None:  # unit weights: scaling by sqrt(1) = 1 changes no float
         coef, *_ = np.linalg.lstsq(A, y, rcond=None)
     else:
-        sw = np.sqrt(w)[:, None]
+        sw = np.sqrt(np.asarray(weights, dtype=float))[:, None]
         coef, *_ = np.linalg.lstsq(A * sw, y * sw, rcond=None)
-    factorial = np.array([math.factorial(k) for k in range(degree + 1)], dtype=float)
-    return coef * factorial[:, None]
+    return coef * _factorials(degree)
+
+
+@functools.lru_cache(maxsize=8)
+def _factorials(degree: int) -> np.ndarray:
+    """(degree + 1, 1): k! in row k, built once (a fit runs every frame)."""
+    return np.array([math.factorial(k) for k in range(degree + 1)], dtype=float)[:, None]
 
 
 @dataclass(frozen=True)
@@ -215,10 +220,11 @@ def angle_rate(window: SlidingWindow, period: float = 360.0, min_samples: int = 
     """
     if len(window) < min_samples or window.span < min_span - 1e-9:
         return _NAN
-    t, v, _ = window.arrays()
-    y = v[:, 0]
-    ok = np.isfinite(y)
-    if ok.sum() < min_samples or t[ok][-1] - t[ok][0] < min_span - 1e-9:
+    # The finite samples as Python floats, then one array each: a frame's window holds a
+    # handful, and numpy's masking of them cost more than the fit around it.
+    finite = [(t, v) for t, v in window.first_values() if math.isfinite(v)]
+    if len(finite) < min_samples or finite[-1][0] - finite[0][0] < min_span - 1e-9:
         return _NAN
-    y = unwrap(y[ok], period)
-    return float(derivatives_at(t[ok], y, 1, float(t[ok][-1]))[1, 0])  # a line: any time
+    t = np.array([s[0] for s in finite])
+    y = unwrap(np.array([s[1] for s in finite]), period)
+    return float(derivatives_at(t, y, 1, finite[-1][0])[1, 0])  # a line: any time

@@ -14,7 +14,7 @@ from dataclasses import dataclass
 import cv2
 import numpy as np
 
-from monopic.pose.warp import warp
+from monopic.pose.warp import WarpBuffers, warp
 
 # MediaPipe's pose graphs enlarge the keypoint-aligned square by 1.25 on each side.
 DEFAULT_SCALE = 1.25
@@ -57,14 +57,15 @@ class Region:
         b = np.array([self.cx, self.cy]) - a @ np.array([size / 2, size / 2])
         return np.hstack([a, b[:, None]])
 
-    def crop(self, image: np.ndarray, size: int) -> np.ndarray:
+    def crop(self, image: np.ndarray, size: int, buffers: WarpBuffers | None = None) -> np.ndarray:
         """The region resampled to size x size x 3 (zero outside the image); the image is
-        RGB or, cheaper to warp, its four-channel form (monopic.pose.warp)."""
+        RGB or, cheaper to warp, its four-channel form (monopic.pose.warp). With `buffers`
+        the crop is written there (`warp`)."""
         m = self.crop_to_image(size)
         # warpAffine samples pixel centres: shift by half a pixel on both sides.
         m_idx = m.copy()
         m_idx[:, 2] += m[:, :2] @ np.array([0.5, 0.5]) - 0.5
-        return warp(image, m_idx, (size, size), cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP)
+        return warp(image, m_idx, (size, size), cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, buffers)
 
     def to_image(self, points: np.ndarray, size: int) -> np.ndarray:
         """Crop coordinates (N, 2) in 0..size to image pixels (N, 2)."""

@@ -6,12 +6,33 @@ here, the detector's 224 px letterbox of the whole frame 0.24 against 0.41 ms, t
 bytes in the colour channels, and the frame's one conversion to four channels 0.14 ms
 (bench/crop_warp.py). So the tracker widens each frame once (`four_channel`) and every
 warp of it reads that; `warp` widens a three-channel image itself when given one.
+
+The landmark model's crop is warped into the same buffers frame after frame
+(`WarpBuffers`): fresh ones are fresh pages, each faulted in on first write, about 0.1 ms
+of a tracked frame right after a model run here (crop, conversion and the model's float
+input together, 0.47 against 0.57 ms, same bytes; docs/benchmarks.md, session 20).
 """
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import cv2
 import numpy as np
+
+
+@dataclass(frozen=True)
+class WarpBuffers:
+    """Output buffers of `warp` for one size (w, h), reused call after call: each call
+    overwrites what the last one returned."""
+
+    four: np.ndarray  # (h, w, 4) uint8: warpAffine's output
+    three: np.ndarray  # (h, w, 3) uint8: its colour channels, what `warp` returns
+
+    @classmethod
+    def of(cls, size: tuple[int, int]) -> WarpBuffers:
+        w, h = size
+        return cls(np.empty((h, w, 4), np.uint8), np.empty((h, w, 3), np.uint8))
 
 
 def four_channel(image: np.ndarray) -> np.ndarray:
@@ -23,19 +44,29 @@ def four_channel(image: np.ndarray) -> np.ndarray:
     return cv2.cvtColor(image, cv2.COLOR_RGB2RGBA)
 
 
-def warp(image: np.ndarray, matrix: np.ndarray, size: tuple[int, int], flags: int) -> np.ndarray:
+def warp(
+    image: np.ndarray,
+    matrix: np.ndarray,
+    size: tuple[int, int],
+    flags: int,
+    buffers: WarpBuffers | None = None,
+) -> np.ndarray:
     """cv2.warpAffine of the image's colour channels into `size` (w, h), zero outside.
 
     Returns a contiguous (h, w, 3) copy of the result's colour channels: dropping the
     fourth channel costs 5 us, and the models' float conversion of a contiguous crop then
-    takes 40 us against 230-390 us through the strided view (session 16, one core).
+    takes 40 us against 230-390 us through the strided view (session 16, one core). With
+    `buffers` (of this size) the result is `buffers.three`, overwritten by the next call.
     """
+    if buffers is not None and buffers.three.shape[1::-1] != tuple(size):
+        raise ValueError(f"buffers of {buffers.three.shape[1::-1]} for a warp into {size}")
     out = cv2.warpAffine(
         four_channel(image),
         matrix,
         size,
+        dst=None if buffers is None else buffers.four,
         flags=flags,
         borderMode=cv2.BORDER_CONSTANT,
         borderValue=(0, 0, 0, 0),
     )
-    return cv2.cvtColor(out, cv2.COLOR_RGBA2RGB)
+    return cv2.cvtColor(out, cv2.COLOR_RGBA2RGB, dst=None if buffers is None else buffers.three)

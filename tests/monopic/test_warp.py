@@ -10,7 +10,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from monopic.pose.warp import four_channel, warp
+from monopic.pose.warp import WarpBuffers, four_channel, warp
 
 FLAGS = (cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, cv2.INTER_LINEAR, cv2.INTER_AREA)
 
@@ -31,11 +31,20 @@ def test_warping_the_four_channel_frame_gives_the_rgb_warp_byte_for_byte(
     c, s = math.cos(angle) * scale, math.sin(angle) * scale
     m = np.array([[c, -s, x], [s, c, y]])
     expected = cv2.warpAffine(image, m, (64, 48), flags=flags)  # zero border, as before
+    buffers = WarpBuffers.of((64, 48))
+    buffers.three[:] = 7  # what a previous frame left there
     for given_image in (image, four_channel(image)):
         out = warp(given_image, m, (64, 48), flags)
         assert out.shape == (48, 64, 3)
         assert out.flags["C_CONTIGUOUS"]  # the float conversion reads it at full speed
         assert np.array_equal(out, expected)
+        into = warp(given_image, m, (64, 48), flags, buffers)
+        assert into is buffers.three and np.array_equal(into, expected)
+
+
+def test_buffers_of_another_size_are_refused() -> None:
+    with pytest.raises(ValueError, match=r"buffers of \(64, 48\) for a warp into \(48, 64\)"):
+        warp(np.zeros((8, 8, 3), np.uint8), np.eye(2, 3), (48, 64), 0, WarpBuffers.of((64, 48)))
 
 
 def test_four_channel_keeps_the_colours_and_leaves_a_four_channel_image_alone() -> None:
