@@ -85,6 +85,7 @@ def run_worker(
     detector: str = "float",
     spin: bool = False,
     search: str = "tiles",
+    window_detector: str | None = None,
 ) -> Run:
     cmd, extra_env = worker_command(side, ref_python)
     cmd += ["--frames", str(frames), "--threads", str(threads), "--warmup", str(warmup)]
@@ -93,6 +94,8 @@ def run_worker(
     cmd += ["--model", model if side == OURS else model.removesuffix("-int8")]
     if side == OURS:  # the reference runs MediaPipe's own (float) detector
         cmd += ["--runtime", runtime, "--detector", detector, "--search", search]
+        if window_detector is not None:
+            cmd += ["--window-detector", window_detector]
         cmd += ["--spin"] * spin
     if pin:
         cmd.append("--pin")
@@ -406,6 +409,13 @@ def main() -> None:
         help="our side's person detector (the reference runs MediaPipe's)",
     )
     ap.add_argument(
+        "--window-detector",
+        choices=("float", "int8"),
+        default=None,
+        help="our side's detector on the search's zooms and tiles, smaller than the frame "
+        "(default: --detector's; the whole frame keeps --detector's)",
+    )
+    ap.add_argument(
         "--spin",
         action="store_true",
         help="our side's onnxruntime threads spin-wait within a run, as XNNPACK's "
@@ -450,6 +460,7 @@ def main() -> None:
                     detector=args.detector,
                     spin=args.spin,
                     search=args.search,
+                    window_detector=args.window_detector,
                 )
                 loads += [run.load_before, run.load_after]
                 col.runs.append(run)
@@ -474,6 +485,7 @@ def main() -> None:
         "runtime": args.runtime,
         "model": args.model,
         "detector": args.detector,
+        "window_detector": args.window_detector,
         "spin": args.spin,
         "search": args.search,
         "load_min": min(loads),
@@ -503,6 +515,7 @@ def main() -> None:
         f"{n} frames 768x432 in {len(fs.sequences)} sequences ({seqs}); "
         f"sides {', '.join(sides)} (ours on onnxruntime's {args.runtime} execution provider, "
         f"landmark model {args.model}, {args.detector} detector"
+        f"{f' ({args.window_detector} on zooms and tiles)' if args.window_detector else ''}"
         f"{', threads spinning within runs' if args.spin else ''}"
         f"{', searching the whole frame only' if args.search == 'whole-frame' else ''}); "
         f"{args.rounds} ABBA rounds per thread count, {args.warmup} warm-up frames per run; "

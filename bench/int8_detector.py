@@ -63,14 +63,18 @@ def all_windows(width: int, height: int) -> list[Window]:
     return [Window(0, 0, width, height), *[w for level in levels for w in level]]
 
 
-def detector_with(path: Path | None) -> PoseDetector:
-    """The shipped detector; with `path`, its session runs that file instead."""
+def detector_with(path: Path | None, windows_only: bool = False) -> PoseDetector:
+    """The shipped detector; with `path`, its session runs that file instead (with
+    `windows_only`, on the windows smaller than the frame only, as the tracker's
+    `window_detector`)."""
     detector = PoseDetector(1)
     if path is not None:
         session = make_session(path, 1)
         if session.get_inputs()[0].name != detector.input_name:
             raise SystemExit(f"int8_detector: {path} does not take the detector's input")
-        detector.session = session
+        detector._window_session = session
+        if not windows_only:
+            detector.session = session
     return detector
 
 
@@ -122,7 +126,7 @@ def cmd_judge(args: argparse.Namespace) -> None:
     recorder = Recorder("int8_detector", TITLE)
     fs = load(*build(recipe=LARGE))
     h, w = fs.images.shape[1:3]
-    dets = {FLOAT: detector_with(None), INT8: detector_with(args.model)}
+    dets = {FLOAT: detector_with(None), INT8: detector_with(args.model, args.windows_only)}
     windows = all_windows(w, h)
     found = {FLOAT: 0, INT8: 0}
     both = only_float = only_int8 = 0
@@ -165,6 +169,7 @@ def cmd_judge(args: argparse.Namespace) -> None:
     results: dict[str, Any] = {
         "model": str(args.model),
         "model_bytes": args.model.stat().st_size,
+        "windows_only": args.windows_only,
         "frames": len(fs),
         "windows": n_win,
         "windows_found_float": found[FLOAT],
@@ -189,7 +194,12 @@ def cmd_judge(args: argparse.Namespace) -> None:
     lines = [
         f"Candidate `{args.model}` ({args.model.stat().st_size:,} bytes) against the shipped "
         f"float `pose_detection.onnx` on the large frame set ({len(fs)} frames, "
-        f"{len(windows)} windows each: the whole frame and the search cascade's tiles).",
+        f"{len(windows)} windows each: the whole frame and the search cascade's tiles)"
+        + (
+            ", the candidate on the windows smaller than the frame only."
+            if args.windows_only
+            else "."
+        ),
         "",
         "| | float | int8 |",
         "| --- | ---: | ---: |",
@@ -227,6 +237,12 @@ def main() -> None:
     j = sub.add_parser("judge", help="judge an int8 detector against the float one")
     j.add_argument("model", type=Path)
     j.add_argument("--rounds", type=int, default=4)
+    j.add_argument(
+        "--windows-only",
+        action="store_true",
+        help="the candidate runs on the zooms and tiles only, the float model on the whole "
+        "frame (TrackerConfig.window_detector)",
+    )
     j.add_argument("--no-append", action="store_true")
     args = ap.parse_args()
     cmd_windows(args) if args.cmd == "windows" else cmd_judge(args)

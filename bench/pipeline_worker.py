@@ -7,7 +7,8 @@ as shipped: the pruned landmark model and MediaPipe's heatmap refinement
 (monopic.pose.landmarks.refine_from_heatmap), as in the reference graph.
 
     .venv/bin/python bench/pipeline_worker.py --frames recordings/bench/frames-*.npy --threads 1
-        [--model lite|full|heavy|full-int8] [--detector float|int8] [--runtime cpu|openvino]
+        [--model lite|full|heavy|full-int8] [--detector float|int8]
+        [--window-detector float|int8] [--runtime cpu|openvino]
         [--spin] [--search tiles|whole-frame]
 """
 
@@ -41,6 +42,7 @@ class OurRunner:
             threads=args.threads,
             model=args.model,
             detector=args.detector,
+            window_detector=args.window_detector,
             runtime=args.runtime,
             spin=args.spin,
             # MediaPipe's search: the whole frame only, no tiles nor zooms for far pedestrians.
@@ -78,6 +80,12 @@ class OurRunner:
 def options(ap: argparse.ArgumentParser) -> None:
     ap.add_argument("--model", choices=("lite", "full", "heavy", "full-int8"), default="full")
     ap.add_argument("--detector", choices=("float", "int8"), default="float")
+    ap.add_argument(
+        "--window-detector",
+        choices=("float", "int8"),
+        default=None,
+        help="the detector on the search's zooms and tiles (default: --detector's)",
+    )
     ap.add_argument("--runtime", choices=("cpu", "openvino"), default="cpu")
     ap.add_argument("--spin", action="store_true", help="threads spin-wait within a run")
     ap.add_argument(

@@ -61,10 +61,20 @@ class PoseDetector:
         spin: bool = False,
         zoom_score: float | None = None,
         region_scale: float = DEFAULT_SCALE,
+        window_model: str | None = None,
     ) -> None:
         # Both detector models share inputs and outputs (monopic.pose.sessions).
         path = model_path(detector_file(model))
         self.session = make_session(path, threads, spin=spin, runtime=runtime)
+        # `window_model` runs on the windows smaller than the frame (the search's zooms and
+        # tiles, for walkers the whole frame cannot see), `model` on the whole frame; by
+        # default `model` on both.
+        window_path = path if window_model is None else model_path(detector_file(window_model))
+        self._window_session = (
+            self.session
+            if window_path == path
+            else make_session(window_path, threads, spin=spin, runtime=runtime)
+        )
         # A frame's windows are independent passes: with more than one thread they run side
         # by side, one single-threaded pass per thread (onnxruntime runs a session from
         # several threads at once, each on its caller's thread), rather than one after
@@ -74,6 +84,11 @@ class PoseDetector:
         self._tiles: ThreadPoolExecutor | None = None
         if threads > 1 and runtime == "cpu":
             self._tile_session = make_session(path, 1, runtime=runtime)
+            self._window_tile_session = (
+                self._tile_session
+                if window_path == path
+                else make_session(window_path, 1, runtime=runtime)
+            )
             self._tiles = ThreadPoolExecutor(threads, thread_name_prefix="tiles")
             weakref.finalize(self, self._tiles.shutdown, wait=False)
         self.input_name = self.session.get_inputs()[0].name
@@ -92,7 +107,9 @@ class PoseDetector:
         after another (`detect_first` runs windows side by side)."""
         h, w = image.shape[:2]
         windows = windows or [Window(0, 0, w, h)]
-        found = [det for win in windows for det in self._look(image, win, self.session)[0]]
+        found = [
+            det for win in windows for det in self._look(image, win, self._session(image, win))[0]
+        ]
         return weighted_nms(found, NMS_IOU)
 
     def detect_first(
@@ -126,7 +143,8 @@ class PoseDetector:
         def start(win: Window) -> None:
             nonlocal runs
             if win not in running:
-                running[win] = self._tiles.submit(self._look, image, win, self._tile_session)
+                session = self._session(image, win, pooled=True)
+                running[win] = self._tiles.submit(self._look, image, win, session)
                 runs += 1
 
         try:
@@ -148,8 +166,17 @@ class PoseDetector:
     def look(self, image: np.ndarray, win: Window) -> tuple[list[Detection], Faint | None]:
         """One detector pass on `win`: its detections after weighted NMS, and, when there
         are none, its best anchor if that reaches the zoom's threshold (a faint candidate)."""
-        raw, faint = self._look(image, win, self.session)
+        raw, faint = self._look(image, win, self._session(image, win))
         return weighted_nms(raw, NMS_IOU), faint
+
+    def _session(self, image: np.ndarray, win: Window, pooled: bool = False) -> InferenceSession:
+        """The session for `win`: the window model's unless it is the whole frame; with
+        `pooled`, the single-threaded twin a pool thread runs."""
+        h, w = image.shape[:2]
+        whole = (win.x, win.y, win.width, win.height) == (0, 0, w, h)
+        if pooled:
+            return self._tile_session if whole else self._window_tile_session
+        return self.session if whole else self._window_session
 
     def _look(
         self, image: np.ndarray, win: Window, session: InferenceSession

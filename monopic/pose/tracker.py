@@ -54,6 +54,11 @@ class TrackerConfig:
     # The person detector: "float" (MediaPipe's) or "int8" (quantised; faster passes
     # while searching, monopic.pose.sessions.DETECTOR_MODELS).
     detector: str = DEFAULT_DETECTOR_MODEL
+    # The detector for the search's windows smaller than the frame (zooms and tiles, for
+    # walkers the whole frame cannot see); None: `detector`. "int8" there keeps every
+    # whole-frame detection, and so the landmarks of the walkers it finds, the float
+    # model's, and makes the search for far walkers cheaper.
+    window_detector: str | None = None
     # onnxruntime's execution provider for both models (monopic.pose.sessions.RUNTIMES).
     runtime: str = DEFAULT_RUNTIME
     min_detection_score: float = 0.5
@@ -90,6 +95,8 @@ class TrackerConfig:
     def __post_init__(self) -> None:
         landmark_file(self.model)  # an unknown name fails here, with the choices
         detector_file(self.detector)
+        if self.window_detector is not None:
+            detector_file(self.window_detector)
         check_runtime(self.runtime)
         if self.zoom_score is not None and not 0 < self.zoom_score < self.min_detection_score:
             raise ValueError(
@@ -131,6 +138,7 @@ class PoseTracker:
             cfg.spin,
             cfg.zoom_score,
             cfg.region_scale,
+            cfg.window_detector,
         )
         self.landmarks = LandmarkModel(cfg.threads, cfg.model, cfg.runtime, cfg.spin)
         self._region: Region | None = None

@@ -328,6 +328,37 @@ def test_the_int8_detector_finds_the_walker_where_the_float_one_does():
         assert np.abs(a[0].keypoints - b[0].keypoints).max() < 0.05 * height
 
 
+@pytest.mark.parametrize("threads", [1, 2])
+def test_the_window_detector_runs_on_zooms_and_tiles_and_the_whole_frame_keeps_its_own(threads):
+    """`window_model` (TrackerConfig.window_detector): the whole frame gives the float
+    detector's detections bit for bit, a tile the int8 detector's, alone or beside other
+    windows on two threads."""
+    frame = small_person_frame()
+    whole, tiles = Window(0, 0, 768, 432), tile_windows(768, 432, 216)
+    mixed = PoseDetector(threads=threads, model="float", window_model="int8")
+    float_det, int8_det = PoseDetector(model="float"), PoseDetector(model="int8")
+
+    def same(a: list[Detection], b: list[Detection]) -> bool:
+        return len(a) == len(b) and all(
+            x.score == y.score and x.box == y.box and np.array_equal(x.keypoints, y.keypoints)
+            for x, y in zip(a, b, strict=True)
+        )
+
+    near = next(iter(VideoSource(str(CLIP)))).image
+    assert float_det.detect(near) and same(mixed.detect(near), float_det.detect(near))
+    assert not same(int8_det.detect(near), float_det.detect(near))
+    found = [t for t in tiles if int8_det.detect(frame, [t])]
+    assert found  # the small walker is in some tile
+    assert same(mixed.detect(frame, [found[0]]), int8_det.detect(frame, [found[0]]))
+    assert not same(int8_det.detect(frame, [found[0]]), float_det.detect(frame, [found[0]]))
+    # The search: the whole frame finds no one here, then the first tile with someone.
+    dets, _ = mixed.detect_first(frame, SearchSteps(whole, tiles, 0, 0))
+    want, _ = int8_det.detect_first(frame, SearchSteps(whole, tiles, 0, 0))
+    assert same(dets, want)
+    with pytest.raises(ValueError, match="unknown detector model 'fp16'"):
+        TrackerConfig(window_detector="fp16")
+
+
 def test_spinning_threads_spin_within_runs_only_and_give_the_same_landmarks():
     """`spin` (issue 21) lets a 2-thread pool spin-wait between operators and stops it
     when a run returns; one thread has no pool to spin. Spinning changes when threads
