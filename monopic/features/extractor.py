@@ -80,7 +80,8 @@ def foot_point(
         u, v = (x0 + x1) / 2, y1
     pair = _COLUMN_PAIRS.get(column)
     if pair is not None and min(pose.visibility[i] for i in pair) >= MIN_FOOT_VISIBILITY:
-        u = float(pose.landmarks[list(pair), 0].mean())
+        left, right = pair
+        u = (float(pose.landmarks[left, 0]) + float(pose.landmarks[right, 0])) / 2  # np.mean's
     return u, v
 
 

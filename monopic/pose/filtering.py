@@ -105,6 +105,8 @@ class OneEuroFilter:
     def alpha(self, cutoff: float | np.ndarray) -> float | np.ndarray:
         """Weight of the newest sample for a cutoff frequency (Hz) at the current rate."""
         te = 1.0 / self._rate
+        if isinstance(cutoff, float):  # Python floats, the same IEEE steps, no numpy calls
+            return 1.0 / (1.0 + 1.0 / (2.0 * math.pi * cutoff) / te)
         tau = 1.0 / (2.0 * math.pi * np.asarray(cutoff, dtype=np.float64))
         return 1.0 / (1.0 + tau / te)
 

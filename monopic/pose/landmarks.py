@@ -50,12 +50,8 @@ class Pose:
     def box(self) -> tuple[float, float, float, float]:
         """Bounding box of the 33 landmarks (xmin, ymin, xmax, ymax)."""
         xy = self.landmarks[:, :2]
-        return (
-            float(xy[:, 0].min()),
-            float(xy[:, 1].min()),
-            float(xy[:, 0].max()),
-            float(xy[:, 1].max()),
-        )
+        (x0, y0), (x1, y1) = xy.min(axis=0).tolist(), xy.max(axis=0).tolist()
+        return x0, y0, x1, y1
 
     @property
     def height(self) -> float:
@@ -144,18 +140,17 @@ def refine_from_heatmap(points: np.ndarray, heatmap: np.ndarray, size: int) -> n
     """
     hh, hw, channels = heatmap.shape
     k = min(channels, len(points))
-    dims = np.array([hw, hh])
-    last = dims - 1
+    dims, last = _map_bounds(hw, hh)  # (2,) and (2, 1): columns, rows
     # Few, whole-array steps: right after a model run each numpy call costs 5-20 us here
-    # (cold code), about three times its cost in a loop of its own (session 20).
+    # (cold code), several times its cost in a loop of its own (session 20).
     cell = (points[:k, :2] / size * dims).astype(int)  # (k, 2) column, row; a cast truncates
-    centre = np.minimum(np.maximum(cell, 0), last)
+    centre = np.minimum(np.maximum(cell, 0), last[:, 0])
     inside = (cell == centre).all(axis=1)
     # The k windows' columns and rows, (k, 2, 7), around the cell moved onto the map; cells
     # off the map get confidence 0 (the calculator cuts its window there instead, which
     # sums the same).
     win = centre[:, :, None] + _WINDOW
-    at = np.minimum(np.maximum(win, 0), last[:, None])
+    at = np.minimum(np.maximum(win, 0), last)
     on = at == win
     # One gather from the channels-first map (no copy when `heatmap` is the model output's
     # (H, W, C) view): faster than indexing the strided view.
@@ -164,14 +159,21 @@ def refine_from_heatmap(points: np.ndarray, heatmap: np.ndarray, size: int) -> n
     with np.errstate(over="ignore"):  # exp(huge) -> inf -> confidence 0
         conf = np.where(on[:, 1, :, None] & on[:, 0, None, :], 1.0 / (1.0 + np.exp(-logits)), 0.0)
     total = conf.sum(axis=(1, 2))
-    ok = inside & (conf.max(axis=(1, 2)) >= HEATMAP_MIN_CONFIDENCE) & (total > 0)
-    safe = np.where(total > 0, total, 1.0)
-    x = (conf.sum(axis=1) * win[:, 0]).sum(axis=1) / safe / hw * size
-    y = (conf.sum(axis=2) * win[:, 1]).sum(axis=1) / safe / hh * size
+    positive = total > 0
+    ok = inside & (conf.max(axis=(1, 2)) >= HEATMAP_MIN_CONFIDENCE) & positive
+    # Column then row weights, (k, 2, 7): the weighted mean cell of each, x and y at once.
+    weights = np.stack((conf.sum(axis=1), conf.sum(axis=2)), axis=1)
+    mean = (weights * win).sum(axis=2) / np.where(positive, total, 1.0)[:, None]
     out = np.array(points, dtype=np.float64)
-    out[:k, 0] = np.where(ok, x, out[:k, 0])
-    out[:k, 1] = np.where(ok, y, out[:k, 1])
+    out[:k] = np.where(ok[:, None], mean / dims * size, out[:k])
     return out
+
+
+@functools.lru_cache(maxsize=4)
+def _map_bounds(width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    """(width, height) and their last cells as a column, built once per map size."""
+    dims = np.array([width, height])
+    return dims, (dims - 1)[:, None]
 
 
 @functools.lru_cache(maxsize=4)
