@@ -13,7 +13,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from hypothesis.extra.numpy import arrays
 
-from monopic.features.window import median, unwrap
+from monopic.features.window import median
 from monopic.variants.zone import point_in_polygon, points_in_polygon
 
 FLOATS = st.floats(-1e4, 1e4, allow_nan=False, allow_infinity=False)
@@ -71,16 +71,3 @@ def test_median_is_numpys_median(values: list[float]) -> None:
     """Without -0.0 (the head window holds |facing|): which of 0.0 and -0.0 is the middle
     one is np.partition's choice, not a value."""
     assert bits(median(values)) == bits(np.median(np.array(values)))
-
-
-@given(
-    st.lists(st.one_of(FLOATS, st.just(-0.0)), min_size=1, max_size=30),
-    st.sampled_from([360.0, 2 * np.pi]),
-)
-def test_unwrap_is_numpys_unwrap(values: list[float], period: float) -> None:
-    y = np.array(values)
-    assert np.array_equal(bits(unwrap(y, period)), bits(np.unwrap(y, period=period)))
-
-
-def test_unwrap_takes_out_a_jump_across_the_period() -> None:
-    assert unwrap(np.array([170.0, -170.0, -160.0]), 360.0).tolist() == [170.0, 190.0, 200.0]

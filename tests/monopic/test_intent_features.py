@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 from monopic.camera import CameraModel
 from monopic.features.extractor import DEFAULT_ROBOT_WIDTH, FeatureExtractor
@@ -26,6 +28,7 @@ from monopic.features.window import (
     SlidingWindow,
     angle_rate,
     derivatives_at,
+    line_slope,
 )
 from monopic.frame import EgoState
 from monopic.pipeline import Pipeline, PipelineConfig
@@ -191,6 +194,22 @@ def test_angle_rate_is_the_slope_and_unwraps_at_the_profile() -> None:
     two.add(0.0, 1.0)
     two.add(0.3, 2.0)
     assert math.isnan(angle_rate(two))  # fewer than three samples
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(st.floats(0.02, 0.2), min_size=2, max_size=11),
+    st.lists(st.floats(-180.0, 180.0), min_size=12, max_size=12),
+    st.floats(0.0, 1e4),
+)
+def test_the_line_slope_is_the_least_squares_slope(steps, values, start) -> None:
+    """line_slope's centred sums against the degree-1 lstsq fit it replaced."""
+    t = (start + np.concatenate([[0.0], np.cumsum(steps)])).tolist()
+    y = values[: len(t)]
+    fit = float(derivatives_at(np.array(t), np.array(y), 1, t[-1])[1, 0])
+    assert line_slope(t, y) == pytest.approx(fit, rel=1e-9, abs=1e-9)
+    with pytest.raises(ValueError, match="two distinct times"):
+        line_slope([1.0, 1.0], [0.0, 1.0])
 
 
 def _pose(lm: np.ndarray, vis: np.ndarray | None = None) -> Pose:
