@@ -107,6 +107,13 @@ def register(sub: argparse._SubParsersAction) -> None:
         "searching on CPUs with VNNI, the same tracking); default %(default)s",
     )
     p.add_argument(
+        "--window-detector",
+        choices=list(DETECTOR_MODELS),
+        default=None,
+        help="the detector on the search's zooms and tiles (far walkers) only; the whole "
+        "frame keeps --detector's (default: --detector's everywhere)",
+    )
+    p.add_argument(
         "--runtime",
         choices=list(RUNTIMES),
         default=DEFAULT_RUNTIME,
@@ -173,6 +180,7 @@ def run(args: argparse.Namespace) -> int:
                 spin=args.spin,
                 model=args.model,
                 detector=args.detector,
+                window_detector=args.window_detector,
                 runtime=args.runtime,
             ),
             ground_column=GroundColumn(args.ground_column),

@@ -94,3 +94,10 @@ def test_outputs_go_into_folders_made_as_needed(tmp_path):
     assert r.returncode == 2
     (line,) = r.stderr.strip().splitlines()
     assert line.endswith(f"--csv {tmp_path / 'file'}: a file is in the way of this folder")
+
+
+def test_an_unknown_window_detector_is_named_with_the_choices(tmp_path):
+    r = run("x.mp4", "--window-detector", "fp16", cwd=tmp_path)
+    assert r.returncode == 2 and "fp16" in r.stderr and "int8" in r.stderr, r.stderr
+    assert len(r.stderr.strip().splitlines()) == 1
+    assert list(tmp_path.iterdir()) == []
