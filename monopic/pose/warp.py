@@ -8,9 +8,10 @@ bytes in the colour channels, and the frame's one conversion to four channels 0.
 warp of it reads that; `warp` widens a three-channel image itself when given one.
 
 The landmark model's crop is warped into the same buffers frame after frame
-(`WarpBuffers`): fresh ones are fresh pages, each faulted in on first write, about 0.1 ms
-of a tracked frame right after a model run here (crop, conversion and the model's float
-input together, 0.47 against 0.57 ms, same bytes; docs/benchmarks.md, session 20).
+(`WarpBuffers`), the same bytes without a fresh allocation per frame. What that saves is
+within this host's noise: right after a model run, widening a frame, cropping it and
+making the model's float input took 0.56 and 0.64 ms in two runs, against 0.62 with fresh
+arrays (`bench/cold_paths.py`, docs/benchmarks.md session 20).
 """
 
 from __future__ import annotations
