@@ -68,6 +68,7 @@ def _runtime(results: dict[str, Any]) -> str:
     """' on openvino' for a run whose pose models were not on the default runtime, ' with
     full-int8' for one whose landmark model was not the default full one, ' and the int8
     detector' (or ' with the int8 detector') for one whose detector was not the float one,
+    ' and the int8 detector on zooms and tiles' for a window detector unlike that one,
     ', spinning threads' when our onnxruntime threads spin-waited within runs, and ',
     whole-frame search' when ours searched as the reference does (no tiles)."""
     runtime, model = results.get("runtime", "cpu"), results.get("model", "full")
@@ -77,6 +78,9 @@ def _runtime(results: dict[str, Any]) -> str:
     )
     if detector != "float":
         text += f" {'and' if model != 'full' else 'with'} the {detector} detector"
+    window = results.get("window_detector")
+    if window is not None and window != detector:
+        text += f" {'and' if text else 'with'} the {window} detector on zooms and tiles"
     if results.get("spin"):
         text += ", spinning threads"
     if results.get("search", "tiles") != "tiles":

@@ -338,6 +338,10 @@ def test_a_goal_names_a_runtime_or_landmark_model_that_is_not_the_default() -> N
     assert _runtime(both) == " with full-int8 and the int8 detector"
     assert _runtime({"spin": False}) == ""
     assert _runtime({"model": "full-int8", "spin": True}) == " with full-int8, spinning threads"
+    window = {"model": "full-int8", "window_detector": "int8"}
+    assert _runtime(window) == " with full-int8 and the int8 detector on zooms and tiles"
+    assert _runtime({"window_detector": "int8"}) == " with the int8 detector on zooms and tiles"
+    assert _runtime({"detector": "int8", "window_detector": "int8"}) == " with the int8 detector"
     assert _runtime({"search": "tiles"}) == ""
     assert _runtime({"search": "whole-frame"}) == ", whole-frame search"
 
