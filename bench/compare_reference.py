@@ -12,6 +12,11 @@ hour at 15 fps (process CPU time of the timed pass: the energy proxy). The resul
 bench/history.jsonl as one line (bench/history.py) unless --no-append.
 
     .venv/bin/python bench/compare_reference.py [--rounds 2] [--threads 1 2] [--no-append]
+        [--model full|full-int8] [--detector float|int8] [--window-detector float|int8]
+        [--spin] [--search tiles|whole-frame]
+
+Issue 21's goals were judged with `--rounds 5 --model full-int8 --spin --window-detector
+int8` (docs/benchmarks.md, session 20).
 """
 
 from __future__ import annotations
