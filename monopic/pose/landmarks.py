@@ -141,8 +141,8 @@ def refine_from_heatmap(points: np.ndarray, heatmap: np.ndarray, size: int) -> n
     hh, hw, channels = heatmap.shape
     k = min(channels, len(points))
     dims, last = _map_bounds(hw, hh)  # (2,) and (2, 1): columns, rows
-    # Few, whole-array steps: right after a model run each numpy call costs 5-20 us here
-    # (cold code), several times its cost in a loop of its own (session 20).
+    # Few, whole-array steps: right after a model run each numpy call costs 10-40 us here
+    # (cold code; bench/cold_paths.py), many times its cost in a loop of its own.
     cell = (points[:k, :2] / size * dims).astype(int)  # (k, 2) column, row; a cast truncates
     centre = np.minimum(np.maximum(cell, 0), last[:, 0])
     inside = (cell == centre).all(axis=1)
