@@ -16,6 +16,7 @@ into the buffers the landmark model keeps (monopic.pose.warp.WarpBuffers).
 from __future__ import annotations
 
 import argparse
+import itertools
 import os
 import sys
 import time
@@ -36,7 +37,7 @@ TITLE = "The steps around the landmark model: right after a model run against wa
 CLIP = Path(__file__).resolve().parents[1] / "tests" / "data" / "walk_clip.mp4"
 
 
-def steps(model: LandmarkModel, frames: list[np.ndarray]) -> dict[str, Callable[[], object]]:
+def steps(frames: list[np.ndarray]) -> dict[str, Callable[[], object]]:
     """Each step as a call; every call does the same work each time (the crops widen the
     next of the clip's frames to four channels first, as the tracker does each frame)."""
     rng = np.random.default_rng(0)
@@ -45,7 +46,7 @@ def steps(model: LandmarkModel, frames: list[np.ndarray]) -> dict[str, Callable[
     points = rng.uniform(0.0, 256.0, (39, 2))
     h, w = frames[0].shape[:2]
     region = Region(w / 2, h / 2, 220.0, 0.1)
-    order = iter(range(10**9))
+    order = itertools.count()
     buffers = WarpBuffers.of((INPUT_SIZE, INPUT_SIZE))
     tensor = np.empty((INPUT_SIZE, INPUT_SIZE, 3), np.float32)
     scale = np.float32(1.0 / 255.0)
@@ -102,7 +103,7 @@ def main() -> None:
     def run_model() -> None:
         model.session.run(model.output_names, {model.input_name: tensor})
 
-    calls = steps(model, frames)
+    calls = steps(frames)
     times: dict[str, dict[str, list[float]]] = {k: {"cold": [], "warm": []} for k in calls}
     for _ in range(args.rounds):
         for name, call in calls.items():

@@ -18,6 +18,7 @@ constant second derivative, is the same wherever it is read.
 from __future__ import annotations
 
 import functools
+import itertools
 import math
 from collections import deque
 from collections.abc import Sequence
@@ -211,7 +212,7 @@ def angle_rate(window: SlidingWindow, period: float = 360.0, min_samples: int = 
     if len(finite) < min_samples or finite[-1][0] - finite[0][0] < min_span - 1e-9:
         return _NAN
     values = [v for _, v in finite]
-    if any(abs(b - a) >= period / 2 for a, b in zip(values, values[1:], strict=False)):
+    if any(abs(b - a) >= period / 2 for a, b in itertools.pairwise(values)):
         values = np.unwrap(values, period=period).tolist()
     return line_slope([t for t, _ in finite], values)
 

@@ -69,7 +69,7 @@ class PoseDetector:
         # `window_model` runs on the windows smaller than the frame (the search's zooms and
         # tiles, for walkers the whole frame cannot see), `model` on the whole frame; by
         # default `model` on both.
-        window_path = path if window_model is None else model_path(detector_file(window_model))
+        window_path = model_path(detector_file(model if window_model is None else window_model))
         self._window_session = (
             self.session
             if window_path == path
