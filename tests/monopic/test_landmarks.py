@@ -157,3 +157,55 @@ def test_a_model_without_a_heatmap_output_is_refused(monkeypatch: pytest.MonkeyP
     monkeypatch.setattr(landmarks, "make_session", lambda *a, **kw: NoHeatmap(real(*a, **kw)))
     with pytest.raises(ValueError, match="heatmap"):
         LandmarkModel()
+
+
+def test_runs_into_kept_outputs_leave_earlier_poses_untouched() -> None:
+    """The outputs are written into kept arrays (an I/O binding): each run's pose equals a
+    fresh model's, and a later run does not change a pose already returned."""
+    with np.load(FIXTURE) as data:
+        image = data["pose_landmark_full.input"][0]
+    regions = [
+        Region(cx=INPUT_SIZE / 2, cy=INPUT_SIZE / 2, side=INPUT_SIZE, rotation=0.0),
+        Region(cx=INPUT_SIZE / 2 + 9, cy=INPUT_SIZE / 2 - 5, side=INPUT_SIZE * 0.8, rotation=0.3),
+    ]
+    kept = LandmarkModel()
+    first = kept.run(image, regions[0])
+    snapshot = first.landmarks.copy(), first.visibility.copy(), first.aux.copy()
+    second = kept.run(image, regions[1])
+    for got, region in ((first, regions[0]), (second, regions[1])):
+        want = LandmarkModel().run(image, region)
+        np.testing.assert_array_equal(got.landmarks, want.landmarks)
+        np.testing.assert_array_equal(got.visibility, want.visibility)
+        np.testing.assert_array_equal(got.presence, want.presence)
+        np.testing.assert_array_equal(got.aux, want.aux)
+        assert got.score == want.score
+    assert not np.array_equal(first.landmarks, second.landmarks)
+    for before, after in zip(snapshot, (first.landmarks, first.visibility, first.aux), strict=True):
+        np.testing.assert_array_equal(before, after)
+
+
+def test_a_model_whose_output_shape_is_not_fixed_is_refused(
+    monkeypatch: pytest.MonkeyPatch,
+) -> None:
+    from types import SimpleNamespace
+
+    class BatchFree:
+        def __init__(self, session: ort.InferenceSession) -> None:
+            self.inner = session
+
+        def get_inputs(self) -> list[ort.NodeArg]:
+            return self.inner.get_inputs()
+
+        def get_outputs(self) -> list[SimpleNamespace]:
+            return [
+                SimpleNamespace(name=o.name, shape=["batch", *o.shape[1:]])
+                for o in self.inner.get_outputs()
+            ]
+
+    import monopic.pose.landmarks as landmarks
+
+    real = landmarks.make_session
+    monkeypatch.setattr(landmarks, "make_session", lambda *a, **kw: BatchFree(real(*a, **kw)))
+    with pytest.raises(ValueError, match=r"pose_landmark_full\.onnx: output 'landmarks' has "
+                       r"shape \['batch', 195\]; a fixed shape is needed"):  # fmt: skip
+        LandmarkModel()
