@@ -8,7 +8,9 @@ alternated, each step twice: right after a landmark model run (as in the pipelin
 right after running the same step (warm). The steps: the first numpy call, a Python loop,
 a few different numpy calls, the heatmap refinement, and a frame of the shipped clip
 widened to four channels, cropped and made the model's float input, into fresh arrays or
-into the buffers the landmark model keeps (monopic.pose.warp.WarpBuffers).
+into the buffers the landmark model keeps (monopic.pose.warp.WarpBuffers), and the same
+with the frame widened only around the crop, as the tracker does while it tracks
+(monopic.pose.warp.WideFrame).
 
     .venv/bin/python bench/cold_paths.py [--rounds 300] [--threads 1] [--no-append]
 """
@@ -30,7 +32,7 @@ from history import Recorder  # noqa: E402
 
 from monopic.pose.landmarks import INPUT_SIZE, LandmarkModel, refine_from_heatmap  # noqa: E402
 from monopic.pose.region import Region  # noqa: E402
-from monopic.pose.warp import WarpBuffers, four_channel  # noqa: E402
+from monopic.pose.warp import WarpBuffers, WideFrame, four_channel  # noqa: E402
 from monopic.video import VideoSource  # noqa: E402
 
 TITLE = "The steps around the landmark model: right after a model run against warm"
@@ -45,7 +47,8 @@ def steps(frames: list[np.ndarray]) -> dict[str, Callable[[], object]]:
     heatmap = rng.normal(-2.0, 3.0, (39, 64, 64)).astype(np.float32).transpose(1, 2, 0)
     points = rng.uniform(0.0, 256.0, (39, 2))
     h, w = frames[0].shape[:2]
-    region = Region(w / 2, h / 2, 220.0, 0.1)
+    region = Region(w / 2, h / 2, 220.0, 0.1)  # 18 % of a frame widened around it
+    wide = WideFrame()
     order = itertools.count()
     buffers = WarpBuffers.of((INPUT_SIZE, INPUT_SIZE))
     tensor = np.empty((INPUT_SIZE, INPUT_SIZE, 3), np.float32)
@@ -75,6 +78,11 @@ def steps(frames: list[np.ndarray]) -> dict[str, Callable[[], object]]:
         crop = region.crop(frame(), INPUT_SIZE, buffers)
         return np.multiply(crop, scale, out=tensor, dtype=np.float32)
 
+    def crop_around() -> object:
+        wide.start(frames[next(order) % len(frames)])
+        crop = region.crop(wide.around(*region.bounds()), INPUT_SIZE, buffers)
+        return np.multiply(crop, scale, out=tensor, dtype=np.float32)
+
     return {
         "one numpy call (np.add on 80 floats)": lambda: np.add(small, 1.0),
         "a Python loop of 50 additions": python_loop,
@@ -82,6 +90,7 @@ def steps(frames: list[np.ndarray]) -> dict[str, Callable[[], object]]:
         "heatmap refinement (39 points)": lambda: refine_from_heatmap(points, heatmap, 256),
         "frame to 4 channels, crop, float input: fresh arrays": crop_fresh,
         "the same into reused buffers": crop_reused,
+        "the same, the frame widened around the crop only (WideFrame)": crop_around,
     }
 
 

@@ -49,6 +49,12 @@ class Region:
             self.side > 1.0
         )
 
+    def bounds(self) -> tuple[float, float, float, float]:
+        """x0, y0, x1, y1: the rotated square's axis-aligned bounds, continuous image pixels
+        (what a crop of it reads, but for bilinear sampling's neighbours)."""
+        half = self.side / 2 * (abs(math.cos(self.rotation)) + abs(math.sin(self.rotation)))
+        return self.cx - half, self.cy - half, self.cx + half, self.cy + half
+
     def crop_to_image(self, size: int) -> np.ndarray:
         """2x3 affine map from continuous crop coordinates (0..size) to image coordinates."""
         c, s = math.cos(self.rotation), math.sin(self.rotation)

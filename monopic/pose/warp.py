@@ -4,8 +4,10 @@ OpenCV warps a four-channel uint8 image with its vector kernels and a three-chan
 without: a rotated 256 px crop of a 768x432 frame took 0.57 against 0.89 ms on one core
 here, the detector's 224 px letterbox of the whole frame 0.24 against 0.41 ms, the same
 bytes in the colour channels, and the frame's one conversion to four channels 0.14 ms
-(bench/crop_warp.py). So the tracker widens each frame once (`four_channel`) and every
-warp of it reads that; `warp` widens a three-channel image itself when given one.
+(bench/crop_warp.py). So the tracker widens each frame once and every warp of it reads
+that; `warp` widens a three-channel image itself when given one. While it tracks, the
+tracker widens only around the landmark crop (`WideFrame`): the same crop bytes, and
+per frame 0.92-0.97 of the time at 2 threads (session 21, docs/benchmarks.md).
 
 The landmark model's crop is warped into the same buffers frame after frame
 (`WarpBuffers`), the same bytes without a fresh allocation per frame. What that saves is
@@ -16,10 +18,17 @@ arrays (`bench/cold_paths.py`, docs/benchmarks.md session 20).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 import cv2
 import numpy as np
+
+# Pixels widened beyond a region's bounds: bilinear sampling reads the pixel at or left of
+# (above) a sample and the next one, and a sample's index coordinate is its continuous
+# one minus half a pixel, so one pixel each side would do; two leave slack for
+# warpAffine's fixed-point coordinates (1/32 px).
+WIDEN_MARGIN = 2
 
 
 @dataclass(frozen=True)
@@ -34,6 +43,61 @@ class WarpBuffers:
     def of(cls, size: tuple[int, int]) -> WarpBuffers:
         w, h = size
         return cls(np.empty((h, w, 4), np.uint8), np.empty((h, w, 3), np.uint8))
+
+
+class WideFrame:
+    """A frame's four-channel form in a kept buffer, widened only where warps will read.
+
+    While a person is tracked, a frame is warped once, into the landmark crop, which reads
+    a median 7 % of a 768x432 benchmark frame (10-90 %: 2-29 %); widening the whole frame
+    took 0.14 ms right after a model run (bench/cold_paths.py). Outside what has been
+    widened the buffer holds earlier frames' pixels: only `around`'s bounds may be warped
+    from what it returns, `whole` for anything else (the detector's windows). Each `start`
+    overwrites what the last frame's calls returned.
+    """
+
+    def __init__(self) -> None:
+        self._kept: np.ndarray | None = None
+        self._image: np.ndarray | None = None
+        self._view: np.ndarray | None = None
+        self._whole = False
+
+    def start(self, image: np.ndarray) -> None:
+        """A new RGB (H, W, 3) frame, nothing widened yet; a four-channel one is used as is."""
+        if image.ndim == 3 and image.shape[2] == 4:
+            self._image, self._view, self._whole = image, image, True
+            return
+        if image.ndim != 3 or image.shape[2] != 3:
+            raise ValueError(f"expected an RGB image (H, W, 3), got shape {image.shape}")
+        if self._kept is None or self._kept.shape[:2] != image.shape[:2]:
+            self._kept = np.empty((*image.shape[:2], 4), np.uint8)
+        self._image, self._view, self._whole = image, self._kept, False
+
+    def whole(self) -> np.ndarray:
+        """The frame, widened everywhere."""
+        image, view = self._frame()
+        if not self._whole:
+            cv2.cvtColor(image, cv2.COLOR_RGB2RGBA, dst=view)
+            self._whole = True
+        return view
+
+    def around(self, x0: float, y0: float, x1: float, y1: float) -> np.ndarray:
+        """The frame, widened at least over x0..x1, y0..y1 (continuous image pixels, as
+        `Region.bounds`) and WIDEN_MARGIN beyond, where they lie on the frame."""
+        image, view = self._frame()
+        if not self._whole:
+            h, w = image.shape[:2]
+            c0, c1 = max(0, math.floor(x0) - WIDEN_MARGIN), min(w, math.ceil(x1) + WIDEN_MARGIN)
+            r0, r1 = max(0, math.floor(y0) - WIDEN_MARGIN), min(h, math.ceil(y1) + WIDEN_MARGIN)
+            if c0 < c1 and r0 < r1:
+                part = view[r0:r1, c0:c1]
+                cv2.cvtColor(image[r0:r1, c0:c1], cv2.COLOR_RGB2RGBA, dst=part)
+        return view
+
+    def _frame(self) -> tuple[np.ndarray, np.ndarray]:
+        if self._image is None or self._view is None:
+            raise RuntimeError("WideFrame: start() a frame first")
+        return self._image, self._view
 
 
 def four_channel(image: np.ndarray) -> np.ndarray:

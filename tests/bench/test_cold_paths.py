@@ -17,7 +17,7 @@ def test_a_short_run_times_every_step_after_a_model_run_and_warm() -> None:
     )  # fmt: skip
     assert r.returncode == 0, r.stderr
     rows = [line for line in r.stdout.splitlines() if line.startswith("| ") and "x |" in line]
-    assert len(rows) == 6 and all(line.count("|") == 5 for line in rows), r.stdout
+    assert len(rows) == 7 and all(line.count("|") == 5 for line in rows), r.stdout
 
 
 def test_zero_rounds_is_refused_in_one_line() -> None:

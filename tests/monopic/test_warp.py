@@ -1,4 +1,5 @@
-"""monopic.pose.warp: the four-channel warp gives the three-channel warp's bytes."""
+"""monopic.pose.warp: the four-channel warp gives the three-channel warp's bytes, and a
+frame widened only around a region gives that region's crop byte for byte."""
 
 from __future__ import annotations
 
@@ -10,7 +11,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from monopic.pose.warp import WarpBuffers, four_channel, warp
+from monopic.pose.region import Region
+from monopic.pose.warp import WarpBuffers, WideFrame, four_channel, warp
 
 FLAGS = (cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, cv2.INTER_LINEAR, cv2.INTER_AREA)
 
@@ -58,3 +60,53 @@ def test_four_channel_keeps_the_colours_and_leaves_a_four_channel_image_alone() 
 def test_an_image_that_is_not_rgb_is_named(shape: tuple[int, ...]) -> None:
     with pytest.raises(ValueError, match=r"expected an RGB image \(H, W, 3\)"):
         four_channel(np.zeros(shape, dtype=np.uint8))
+
+
+@settings(max_examples=60, deadline=None)
+@given(
+    seed=st.integers(0, 2**32 - 1),
+    cx=st.floats(-80.0, 280.0),
+    cy=st.floats(-80.0, 200.0),
+    side=st.floats(2.0, 260.0),
+    rotation=st.floats(-math.pi, math.pi),
+    size=st.sampled_from((31, 64, 256)),
+)
+def test_a_frame_widened_around_a_region_crops_it_as_the_whole_frame_does(
+    seed: int, cx: float, cy: float, side: float, rotation: float, size: int
+) -> None:
+    rng = np.random.default_rng(seed)
+    before, image = rng.integers(0, 256, (2, 120, 200, 3), dtype=np.uint8)
+    region = Region(cx, cy, side, rotation)
+    wide = WideFrame()
+    wide.start(before)
+    wide.whole()  # the kept buffer now holds another frame's pixels everywhere
+    wide.start(image)
+    got = region.crop(wide.around(*region.bounds()), size)
+    assert np.array_equal(got, region.crop(four_channel(image), size))
+
+
+def test_a_wide_frame_is_widened_whole_once_and_takes_four_channels_as_they_are() -> None:
+    image = np.random.default_rng(3).integers(0, 256, (20, 30, 3), dtype=np.uint8)
+    wide = WideFrame()
+    wide.start(image)
+    whole = wide.whole()
+    assert np.array_equal(whole, four_channel(image))
+    assert wide.around(0.0, 0.0, 1.0, 1.0) is whole  # nothing more to widen
+    rgba = four_channel(image)
+    wide.start(rgba)
+    assert wide.whole() is rgba and wide.around(5.0, 5.0, 9.0, 9.0) is rgba
+
+
+def test_a_wide_frame_names_a_frame_that_is_not_rgb_and_a_missing_start() -> None:
+    with pytest.raises(RuntimeError, match=r"start\(\) a frame first"):
+        WideFrame().whole()
+    with pytest.raises(ValueError, match=r"expected an RGB image \(H, W, 3\), got shape \(4, 4\)"):
+        WideFrame().start(np.zeros((4, 4), np.uint8))
+
+
+def test_a_region_s_bounds_hold_its_corners() -> None:
+    region = Region(50.0, 40.0, 20.0, 0.4)
+    x0, y0, x1, y1 = region.bounds()
+    corners = region.corners()
+    assert np.isclose(corners[:, 0].min(), x0) and np.isclose(corners[:, 0].max(), x1)
+    assert np.isclose(corners[:, 1].min(), y0) and np.isclose(corners[:, 1].max(), y1)
