@@ -55,22 +55,32 @@ class Region:
         half = self.side / 2 * (abs(math.cos(self.rotation)) + abs(math.sin(self.rotation)))
         return self.cx - half, self.cy - half, self.cx + half, self.cy + half
 
-    def crop_to_image(self, size: int) -> np.ndarray:
-        """2x3 affine map from continuous crop coordinates (0..size) to image coordinates."""
+    def _affine(self, size: int) -> tuple[float, float, float, float, float, float]:
+        """crop_to_image's rows (a00, a01, b0, a10, a11, b1) in Python floats, without numpy
+        calls: they run right after a model run, when each is slow (bench/cold_paths.py).
+        For a power-of-two size (the landmark model's 256) the products by size / 2 are
+        exact, so these are the floats numpy's fused 2x2 product gave; for other sizes
+        they may differ from it in the last bit."""
         c, s = math.cos(self.rotation), math.sin(self.rotation)
         k = self.side / size
-        a = np.array([[c * k, -s * k], [s * k, c * k]])
-        b = np.array([self.cx, self.cy]) - a @ np.array([size / 2, size / 2])
-        return np.hstack([a, b[:, None]])
+        a00, a01, a10, a11 = c * k, -s * k, s * k, c * k
+        h = size / 2
+        return a00, a01, self.cx - (a00 * h + a01 * h), a10, a11, self.cy - (a10 * h + a11 * h)
+
+    def crop_to_image(self, size: int) -> np.ndarray:
+        """2x3 affine map from continuous crop coordinates (0..size) to image coordinates."""
+        a00, a01, b0, a10, a11, b1 = self._affine(size)
+        return np.array([[a00, a01, b0], [a10, a11, b1]])
 
     def crop(self, image: np.ndarray, size: int, buffers: WarpBuffers | None = None) -> np.ndarray:
         """The region resampled to size x size x 3 (zero outside the image); the image is
         RGB or, cheaper to warp, its four-channel form (monopic.pose.warp). With `buffers`
         the crop is written there (`warp`)."""
-        m = self.crop_to_image(size)
+        a00, a01, b0, a10, a11, b1 = self._affine(size)
         # warpAffine samples pixel centres: shift by half a pixel on both sides.
-        m_idx = m.copy()
-        m_idx[:, 2] += m[:, :2] @ np.array([0.5, 0.5]) - 0.5
+        b0 += (a00 * 0.5 + a01 * 0.5) - 0.5
+        b1 += (a10 * 0.5 + a11 * 0.5) - 0.5
+        m_idx = np.array([[a00, a01, b0], [a10, a11, b1]])
         return warp(image, m_idx, (size, size), cv2.INTER_LINEAR | cv2.WARP_INVERSE_MAP, buffers)
 
     def to_image(self, points: np.ndarray, size: int) -> np.ndarray:

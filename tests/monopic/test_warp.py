@@ -110,3 +110,27 @@ def test_a_region_s_bounds_hold_its_corners() -> None:
     corners = region.corners()
     assert np.isclose(corners[:, 0].min(), x0) and np.isclose(corners[:, 0].max(), x1)
     assert np.isclose(corners[:, 1].min(), y0) and np.isclose(corners[:, 1].max(), y1)
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    cx=st.floats(-500.0, 1500.0),
+    cy=st.floats(-500.0, 1500.0),
+    side=st.floats(0.01, 3000.0),
+    rotation=st.floats(-7.0, 7.0),
+    size=st.sampled_from((32, 64, 256)),
+)
+def test_the_crop_map_in_python_floats_is_numpy_s_product_for_power_of_two_sizes(
+    cx: float, cy: float, side: float, rotation: float, size: int
+) -> None:
+    """Region builds its affine map without numpy calls; for the landmark model's 256
+    (a power of two) it must be the floats numpy's 2x2 product gives."""
+    c, s = math.cos(rotation), math.sin(rotation)
+    k = side / size
+    a = np.array([[c * k, -s * k], [s * k, c * k]])
+    b = np.array([cx, cy]) - a @ np.array([size / 2, size / 2])
+    numpy_map = np.hstack([a, b[:, None]])
+    region = Region(cx, cy, side, rotation)
+    assert np.array_equal(region.crop_to_image(size), numpy_map)
+    points = np.random.default_rng(0).uniform(0.0, size, (39, 2))
+    assert np.array_equal(region.to_image(points, size), points @ a.T + b)
