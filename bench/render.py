@@ -26,6 +26,7 @@ NARRATIVE = "docs/benchmarks.md"
 # Sections in this order; benchmarks not listed follow by name.
 ORDER = (
     "compare_reference",
+    "goal_runs",
     "landmark_profile",
     "model_choices",
     "int8_landmarks",
