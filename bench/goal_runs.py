@@ -135,9 +135,8 @@ def main() -> None:
     for name, figure in FIGURES.items():
         values = [v for v in (figure(run.results) for run in runs) if v is not None]
         if len(values) >= 2:
-            rows.append({"figure": name, **vars(summarise(values))})
-    rows = [{**r, "verdict": Summary(**{k: r[k] for k in Summary.__dataclass_fields__}).verdict}
-            for r in rows]  # fmt: skip
+            summary = summarise(values)
+            rows.append({"figure": name, **vars(summary), "verdict": summary.verdict})
     commits = sorted({(run.commit or "?")[:7] for run in runs})
     lines = [
         f"{len(runs)} runs of bench/compare_reference.py ({runs[0].date} to {runs[-1].date}; "

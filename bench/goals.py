@@ -48,23 +48,29 @@ def _latency(results: dict[str, Any], threads: int, side: str) -> dict[str, Any]
     return None
 
 
+def _sides(results: dict[str, Any], threads: int) -> tuple[dict[str, Any], dict[str, Any]] | None:
+    """Our and the reference's latency rows at `threads`, when both are there with a ratio."""
+    ours, ref = _latency(results, threads, "ours"), _latency(results, threads, "reference")
+    if ours is None or ref is None or ours.get("ratio_p50_x") is None:
+        return None
+    return ours, ref
+
+
 def p50_ratio(results: dict[str, Any], threads: int) -> float | None:
     """Ours / reference, whole-frame p50 on frames both found, at `threads`, or None."""
-    ours, ref = _latency(results, threads, "ours"), _latency(results, threads, "reference")
-    if ours is None or ref is None:
-        return None
-    return ours.get("ratio_p50_x")
+    sides = _sides(results, threads)
+    return None if sides is None else sides[0]["ratio_p50_x"]
 
 
 def ratio_at(threads: int) -> Callable[[dict[str, Any]], Standing | None]:
     """Ours / reference, whole-frame p50 on frames both found, at `threads` threads."""
 
     def read(results: dict[str, Any]) -> Standing | None:
-        ratio = p50_ratio(results, threads)
-        if ratio is None:
+        sides = _sides(results, threads)
+        if sides is None:
             return None
-        ours, ref = _latency(results, threads, "ours"), _latency(results, threads, "reference")
-        assert ours is not None and ref is not None  # p50_ratio found both
+        ours, ref = sides
+        ratio = ours["ratio_p50_x"]
         return Standing(
             f"{ratio:.2f} ({ours['p50_ms']:.2f} vs {ref['p50_ms']:.2f} ms){_runtime(results)}",
             ratio <= RATIO_GOAL,

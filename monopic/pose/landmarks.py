@@ -98,7 +98,7 @@ class LandmarkModel:
         self._buffers = WarpBuffers.of((INPUT_SIZE, INPUT_SIZE))
         self._tensor = np.empty((1, INPUT_SIZE, INPUT_SIZE, 3), np.float32)
         # The outputs too: onnxruntime writes them into kept arrays (an I/O binding), so a
-        # run neither allocates them nor copies the 640 kB heatmap out (56-61 us a run on
+        # run neither allocates them nor copies the 640 kB heatmap out (62-65 us a run on
         # the AVX-512 EPYC at 1 and 2 threads, bench/io_binding.py; the same values).
         declared = {o.name: o.shape for o in self.session.get_outputs()}
         self._outputs = [

@@ -6,8 +6,9 @@ here, the detector's 224 px letterbox of the whole frame 0.24 against 0.41 ms, t
 bytes in the colour channels, and the frame's one conversion to four channels 0.14 ms
 (bench/crop_warp.py). So the tracker widens each frame once and every warp of it reads
 that; `warp` widens a three-channel image itself when given one. While it tracks, the
-tracker widens only around the landmark crop (`WideFrame`): the same crop bytes, and
-per frame 0.92-0.97 of the time at 2 threads (session 21, docs/benchmarks.md).
+tracker widens only around the landmark crop (`WideFrame`): the same crop bytes, and in
+the 2-thread benchmark worker 87 us a frame for the widening against 138 for the whole
+frame (session 21, docs/benchmarks.md).
 
 The landmark model's crop is warped into the same buffers frame after frame
 (`WarpBuffers`), the same bytes without a fresh allocation per frame. What that saves is
@@ -64,11 +65,9 @@ class WideFrame:
 
     def start(self, image: np.ndarray) -> None:
         """A new RGB (H, W, 3) frame, nothing widened yet; a four-channel one is used as is."""
-        if image.ndim == 3 and image.shape[2] == 4:
+        if _is_four_channel(image):
             self._image, self._view, self._whole = image, image, True
             return
-        if image.ndim != 3 or image.shape[2] != 3:
-            raise ValueError(f"expected an RGB image (H, W, 3), got shape {image.shape}")
         if self._kept is None or self._kept.shape[:2] != image.shape[:2]:
             self._kept = np.empty((*image.shape[:2], 4), np.uint8)
         self._image, self._view, self._whole = image, self._kept, False
@@ -77,7 +76,7 @@ class WideFrame:
         """The frame, widened everywhere."""
         image, view = self._frame()
         if not self._whole:
-            cv2.cvtColor(image, cv2.COLOR_RGB2RGBA, dst=view)
+            four_channel(image, out=view)
             self._whole = True
         return view
 
@@ -90,8 +89,7 @@ class WideFrame:
             c0, c1 = max(0, math.floor(x0) - WIDEN_MARGIN), min(w, math.ceil(x1) + WIDEN_MARGIN)
             r0, r1 = max(0, math.floor(y0) - WIDEN_MARGIN), min(h, math.ceil(y1) + WIDEN_MARGIN)
             if c0 < c1 and r0 < r1:
-                part = view[r0:r1, c0:c1]
-                cv2.cvtColor(image[r0:r1, c0:c1], cv2.COLOR_RGB2RGBA, dst=part)
+                four_channel(image[r0:r1, c0:c1], out=view[r0:r1, c0:c1])
         return view
 
     def _frame(self) -> tuple[np.ndarray, np.ndarray]:
@@ -100,13 +98,21 @@ class WideFrame:
         return self._image, self._view
 
 
-def four_channel(image: np.ndarray) -> np.ndarray:
-    """The RGB uint8 image (H, W, 3) with a fourth channel; a 4-channel image as it is."""
-    if image.ndim == 3 and image.shape[2] == 4:
+def four_channel(image: np.ndarray, out: np.ndarray | None = None) -> np.ndarray:
+    """The RGB uint8 image (H, W, 3) with a fourth channel (written into `out` when
+    given, of the same height and width); a 4-channel image as it is."""
+    if _is_four_channel(image):
         return image
+    return cv2.cvtColor(image, cv2.COLOR_RGB2RGBA, dst=out)
+
+
+def _is_four_channel(image: np.ndarray) -> bool:
+    """True for a four-channel image, False for RGB; anything else is refused."""
+    if image.ndim == 3 and image.shape[2] == 4:
+        return True
     if image.ndim != 3 or image.shape[2] != 3:
         raise ValueError(f"expected an RGB image (H, W, 3), got shape {image.shape}")
-    return cv2.cvtColor(image, cv2.COLOR_RGB2RGBA)
+    return False
 
 
 def warp(
