@@ -66,6 +66,20 @@ def test_a_slowing_walker_reads_a_negative_acceleration_and_a_late_reading_misse
     assert crossfit.delayed(row, 15, 0.0) == 15
 
 
+def test_an_early_reading_sees_the_slowing_before_it_happens() -> None:
+    speeds = [1.2] * 10 + [1.2 - 0.15 * i for i in range(1, 6)]  # slows from frame 11
+    row = walker(speeds)
+    assert crossfit.shifted(row, 5, -0.4) == 11  # 6 frames of 1/15 s later
+    assert crossfit.truth_values(row, crossfit.shifted(row, 5, -0.4))["acceleration"] < -0.5
+    assert crossfit.truth_values(row, crossfit.shifted(row, 5, 0.0))["acceleration"] == (
+        pytest.approx(0.0, abs=1e-9)
+    )
+    assert crossfit.shifted(row, 9, 0.4) == crossfit.delayed(row, 9, 0.4) == 3
+    assert crossfit.shifted(row, 13, -1.0) == 15  # no truth beyond the run: its last frame
+    row.truth.t[14] = None  # a frame without truth is skipped, not read
+    assert crossfit.ahead(row, 13, 1 / 15) == 15
+
+
 def test_the_truths_window_is_the_same_three_frames_on_every_frame() -> None:
     # Speeds alternate frame by frame: a window of 3 frames reads +-0.1 m/s over 0.2 s,
     # one of 4 would read nothing. Times accumulate in floats, as the simulator's do.
@@ -109,6 +123,7 @@ def test_the_hold_back_acts_only_where_the_out_of_fold_share_reaches_the_thresho
 def test_a_reading_names_its_source_its_delay_and_what_it_leaves_out() -> None:
     motion = crossfit.Reading.parse("truth-motion@0.2")
     assert motion.truth and motion.delay == pytest.approx(0.2)
+    assert crossfit.Reading.parse("truth-motion@-0.6").delay == pytest.approx(-0.6)
     assert set(motion.without) == {"phi", "phi_rate", "head_yaw"}
     assert crossfit.Reading.parse("pipeline") == crossfit.Reading("pipeline", False, 0.0, ())
     recent = crossfit.Reading.parse("pipeline-recent")
@@ -203,7 +218,7 @@ def test_bad_input_is_one_line(tmp_path: Path) -> None:
     empty.write_text("")
     late = run_tool(str(empty), "--reading", "pipeline@0.2")
     assert late.returncode == 1 and "only the truth's reading can be made late" in late.stderr
-    for bad in ("eyes", "truth@soon", "truth@-1"):
+    for bad in ("eyes", "truth@soon", "truth@inf", "pipeline@-0.2"):
         got = run_tool(str(empty), "--reading", bad)
         assert got.returncode == 1 and got.stderr.startswith("--reading: ")
         assert len(got.stderr.strip().splitlines()) == 1

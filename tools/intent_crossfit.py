@@ -32,9 +32,13 @@ than the foot's row, so motion across the line of sight is believed sooner), the
 still from the shipped track; `truth` reads every attribute
 from the simulator's truth (a perfect reader, with the head's true yaw), `truth-motion`
 its motion alone, and `@S` reads the truth S seconds late, as an estimator lagging by S.
+`@-S` reads it S seconds early: a cue that shows the walker's motion S seconds before it
+happens, perfectly read. How far ahead would a cue have to tell, for the goal to be in
+reach? (Session 22: the simulator's body cues add nothing to the truth's own motion, so
+this asks what any cue, real or simulated, would need.)
 
     .venv/bin/python tools/intent_crossfit.py RESULTS.jsonl [MORE.jsonl ...]
-        [--reading pipeline|pipeline-recent|pipeline-column|truth|truth-motion[@S] ...]
+        [--reading pipeline|pipeline-recent|pipeline-column|truth|truth-motion[@S|@-S] ...]
         [--folds 5] [--depth 4 6]
         [--min-rows 50] [--out docs/intent/crossfit.md] [--plot docs/images/crossfit.png]
 """
@@ -147,7 +151,7 @@ def collect_run(
         if p is not None and math.isfinite(p):
             history.add(f.features.timestamp, p)
         if reading.truth:
-            values = truth_values(row, delayed(row, f.k, reading.delay))
+            values = truth_values(row, shifted(row, f.k, reading.delay))
         else:
             kin = motion.kinematics()
             if own is not None:  # the motion from the second track, the warning not
@@ -214,6 +218,27 @@ def delayed(row: RunResult, k: int, delay: float) -> int:
     while j > 0 and delay > 0 and (t[j] is None or t[k] - t[j] < delay - 1e-9):  # type: ignore[operator]
         j -= 1
     return j
+
+
+def ahead(row: RunResult, k: int, lead: float) -> int:
+    """The first frame at least `lead` seconds after frame k, or the run's last frame with
+    a time (the truth ends at contact or with the run: a cue cannot tell beyond it)."""
+    t = row.truth.t
+    if t[k] is None or lead <= 0:
+        return k
+    last = k
+    for j in range(k + 1, len(t)):
+        if t[j] is None:
+            continue
+        last = j
+        if t[j] - t[k] >= lead - 1e-9:  # type: ignore[operator]
+            return j
+    return last
+
+
+def shifted(row: RunResult, k: int, delay: float) -> int:
+    """The frame a reading `delay` seconds late reads at frame k (early for a negative one)."""
+    return delayed(row, k, delay) if delay >= 0 else ahead(row, k, -delay)
 
 
 def truth_values(row: RunResult, k: int, window: float = TRUTH_WINDOW) -> dict[str, float]:
@@ -343,22 +368,32 @@ class Trade:
     all: PairedRecall
     worst_low: float
     worst_family: str
+    worst_lost: int = 0  # that family's collision runs warned 1 s ahead by constant velocity only
+    worst_runs: int = 0  # and its collision runs
 
 
 def trade(outs: list[RunOutcome], base: list[RunOutcome], families: list[str]) -> Trade:
-    worst = (math.inf, "")
+    worst: tuple[float, str, PairedRecall | None] = (math.inf, "", None)
     for fam in families:
         pf = paired_recall(
             [o for o in outs if o.family == fam], [o for o in base if o.family == fam]
         )
         if pf.collision_runs and pf.low < worst[0]:
-            worst = (pf.low, fam)
-    return Trade(paired_recall(outs, base), worst[0], worst[1])
+            worst = (pf.low, fam, pf)
+    pw = worst[2]
+    return Trade(
+        paired_recall(outs, base),
+        worst[0],
+        worst[1],
+        worst_lost=pw.only_second if pw else 0,
+        worst_runs=pw.collision_runs if pw else 0,
+    )
 
 
 @dataclass(frozen=True)
 class Reading:
-    """Where the trees' attributes come from: the pipeline, or the truth (late by `delay`)."""
+    """Where the trees' attributes come from: the pipeline, or the truth (late by `delay`,
+    early by -`delay` when it is negative)."""
 
     name: str
     truth: bool
@@ -371,15 +406,19 @@ class Reading:
     def parse(cls, text: str) -> Reading:
         name, _, late = text.partition("@")
         if name not in READINGS:
-            raise UserError(f"--reading: {text!r} is not one of {', '.join(READINGS)} (@S: late)")
+            raise UserError(
+                f"--reading: {text!r} is not one of {', '.join(READINGS)} (@S: late, @-S: early)"
+            )
         try:
             delay = float(late) if late else 0.0
         except ValueError:
             raise UserError(f"--reading: {text!r}: the delay after @ is not seconds") from None
-        if not (math.isfinite(delay) and delay >= 0):
-            raise UserError(f"--reading: {text!r}: the delay must be seconds >= 0")
+        if not math.isfinite(delay):
+            raise UserError(f"--reading: {text!r}: the delay must be a finite number of seconds")
         if delay and name.startswith("pipeline"):
-            raise UserError(f"--reading: {text!r}: only the truth's reading can be made late")
+            raise UserError(
+                f"--reading: {text!r}: only the truth's reading can be made late or early"
+            )
         return cls(
             text,
             name.startswith("truth"),
@@ -430,8 +469,9 @@ def main(argv: list[str] | None = None) -> int:
         help="pipeline (default), pipeline-recent (plus the foot point's velocity over the "
         "last 0.4 s), pipeline-column (motion from a track with the column's own noise), "
         "truth (every attribute, a perfect reader) or truth-motion (its motion alone); @S "
-        "reads the truth S seconds late, as an estimator that lags by S (repeatable: one "
-        "table and one picture for all)",
+        "reads the truth S seconds late, as an estimator that lags by S, @-S S seconds early, "
+        "as a cue that tells the motion S seconds before it happens (repeatable: one table "
+        "and one picture for all)",
     )
     ap.add_argument("--folds", type=int, default=5)
     ap.add_argument("--depth", type=int, nargs="+", default=[4, 6])
@@ -478,8 +518,9 @@ def main(argv: list[str] | None = None) -> int:
     ]
     table = [
         "| reading | depth | hold at share >= | near-miss runs warned | constant velocity | "
-        "recall@1s | difference, points [95 %] | worst family: lower bound |",
-        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | --- |",
+        "recall@1s | difference, points [95 %] | runs lost / gained | worst family: lower "
+        "bound (runs lost of) |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | --- |",
     ]
     curves: dict[tuple[str, int], list[tuple[float, float, float]]] = {}
     for reading in readings:
@@ -506,7 +547,9 @@ def main(argv: list[str] | None = None) -> int:
                     f"{p.near_miss_warned[0]}/{p.near_miss_runs} | {p.near_miss_warned[1]} | "
                     f"{p.warned_1s[0]}/{p.collision_runs} | "
                     f"{100 * p.difference:+.0f} [{100 * p.low:+.0f}, {100 * p.high:+.0f}] | "
-                    f"{s.worst_family}: {100 * s.worst_low:+.0f} |"
+                    f"{p.only_second} / {p.only_first} | "
+                    f"{s.worst_family}: {100 * s.worst_low:+.0f} "
+                    f"({s.worst_lost} of {s.worst_runs}) |"
                 )
                 print(table[-1], file=sys.stderr, flush=True)
                 ratio = p.near_miss_warned[0] / max(p.near_miss_warned[1], 1)

@@ -13,11 +13,14 @@ from hypothesis import strategies as st
 
 from monopic.cases import Case
 from sim.analysis.metrics import (
+    FrameCounts,
+    RunOutcome,
     available_times,
     case_summary,
     compute,
     judge_run,
     paired_difference,
+    paired_recall,
     position_summary,
     summarise,
     wilson,
@@ -374,3 +377,24 @@ def test_the_paired_interval_narrows_with_agreement_and_with_more_runs() -> None
     # Worked by hand for 36 both, 12 first only, 2 second only, none neither: Wilson
     # 0.865-0.989 (48/50) and 0.626-0.857 (38/50), phi = -24 / sqrt(48 * 2 * 38 * 12).
     assert paired_difference(36, 12, 2, 0) == pytest.approx((0.2, 0.0569, 0.3404), abs=1e-4)
+
+
+def _outcome(i: int, onset: float | None, collision: bool = True) -> RunOutcome:
+    return RunOutcome(
+        id=f"r{i}", family="f", kind="collision" if collision else "near-miss", scale="small",
+        case=5, robot_speed=1.0, horizon=1.5, collision_run=collision,
+        contact_time=3.0 if collision else None, warned=onset is not None, onset=onset,
+        onset_latency=onset, frames=FrameCounts(),
+    )  # fmt: skip
+
+
+def test_paired_recall_counts_the_runs_each_method_alone_warned_in_time() -> None:
+    # Contact at 3 s: an onset at 1.5 s is 1.5 s ahead, one at 2.5 s only 0.5 s.
+    first = [_outcome(0, 1.5), _outcome(1, 2.5), _outcome(2, 2.5), _outcome(3, None, False)]
+    second = [_outcome(0, 1.5), _outcome(1, 1.5), _outcome(2, 1.5), _outcome(3, 1.0, False)]
+    p = paired_recall(first, second)
+    assert (p.collision_runs, p.warned_1s) == (3, (1, 3))
+    assert (p.only_first, p.only_second) == (0, 2)  # two runs lost their 1 s warning
+    assert p.near_miss_warned == (0, 1)
+    back = paired_recall(second, first)
+    assert (back.only_first, back.only_second) == (2, 0)
