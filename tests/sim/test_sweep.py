@@ -437,3 +437,22 @@ def test_the_judged_intent_sweep_shares_no_run_or_seed_with_the_training_data() 
     assert max(r.params["pedestrian.behaviour.head_check_probability"] for r in judged) < min(
         r.params["pedestrian.behaviour.head_check_probability"] for r in train
     )
+
+
+def test_the_shipped_trees_judged_spec_draws_intent_judged_e_s_runs() -> None:
+    """docs/intent/verdict.md judges the shipped tree on intent-judged-e's own runs: the two
+    specs must expand to the same scenarios, only the tree differs."""
+    import tomllib
+
+    from sim.runs.sweep import expand_spec, load_spec, parse_spec
+    from tests.paths import ROOT, SCENARIOS
+
+    judged_path = SCENARIOS / "sweeps" / "intent-judged-e.toml"
+    data = tomllib.loads(judged_path.read_text())
+    data.pop("intent_tree")  # session 13's tree, made later from recordings/
+    judged = expand_spec(parse_spec(judged_path, data))
+    shipped_spec = load_spec(SCENARIOS / "sweeps" / "intent-judged-e-shipped.toml")
+    shipped = expand_spec(shipped_spec)
+    assert shipped_spec.intent_tree == (ROOT / "monopic" / "tree" / "ground_tree.json").resolve()
+    assert len(shipped) == len(judged) == 4 * 128 + 3 * 32
+    assert [(r.id, r.scenario) for r in shipped] == [(r.id, r.scenario) for r in judged]
