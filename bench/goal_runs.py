@@ -1,7 +1,7 @@
 """Issue 21's goals over many runs of bench/compare_reference.py: mean and 95 % interval.
 
 On this shared host one run's ratio moves by 15-25 % with the minute-to-minute speed
-(docs/status.md, session 19), so a goal near its bound is judged on the runs of one
+(docs/history.md, session 19), so a goal near its bound is judged on the runs of one
 setting: the mean over runs with its 95 % t-interval. A goal is met when the interval's
 upper end is within the bound; when only the mean is, it is met on the mean, within the
 noise, which does not close it.
