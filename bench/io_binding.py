@@ -44,7 +44,7 @@ def paired(model: LandmarkModel, rounds: int) -> dict[str, float]:
         plain_times.append(time.perf_counter() - t0)
         between.sum()
         t0 = time.perf_counter()
-        model.session.run_with_iobinding(model._binding)
+        model._infer()
         bound_times.append(time.perf_counter() - t0)
     plain, bound = np.array(plain_times), np.array(bound_times)
     return {
@@ -75,7 +75,7 @@ def main() -> None:
         model = LandmarkModel(threads, args.model)
         model.run(image, Region(w / 2, h / 2, 0.8 * h, 0.0))  # fills the input tensor
         plain = model.session.run(model.output_names, {model.input_name: model._tensor})
-        model.session.run_with_iobinding(model._binding)
+        model._infer()
         same = all(np.array_equal(a, b) for a, b in zip(plain, model._outputs, strict=True))
         if not same:
             raise SystemExit("io_binding: the bound run's outputs differ from the plain run's")

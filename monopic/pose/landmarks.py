@@ -113,11 +113,7 @@ class LandmarkModel:
         # Cast and scale in one pass into the input buffer: each value float32(v) *
         # float32(1 / 255), as a cast then a scale.
         np.multiply(crop, np.float32(1.0 / 255.0), out=self._tensor[0], dtype=np.float32)
-        # The input is bound before every run (under 1 us): OpenVINO's plug-in copies an
-        # input when it is bound, so a binding made once ran every crop as the array stood
-        # then (landmarks 80-100 px off the CPU runtime's; tests/monopic/test_tracker.py).
-        self._binding.bind_cpu_input(self.input_name, self._tensor)
-        self.session.run_with_iobinding(self._binding)
+        self._infer()
         points, flag, heatmap = self._outputs
         pts = points.reshape(NUM_POINTS, 5).astype(np.float64)
         # (H, W, C) view of the channels-first map: no copy, the refinement gathers 7x7.
@@ -135,6 +131,16 @@ class LandmarkModel:
             region=region,
             aux=xy[NUM_LANDMARKS:],
         )
+
+    def _infer(self) -> None:
+        """Run the model on the input buffer into the kept output arrays.
+
+        The input is bound before every run (under 1 us): OpenVINO's plug-in copies an
+        input when it is bound, so a binding made once ran every crop as the array stood
+        then (landmarks 80-100 px off the CPU runtime's; tests/monopic/test_tracker.py).
+        """
+        self._binding.bind_cpu_input(self.input_name, self._tensor)
+        self.session.run_with_iobinding(self._binding)
 
 
 def refine_from_heatmap(points: np.ndarray, heatmap: np.ndarray, size: int) -> np.ndarray:
