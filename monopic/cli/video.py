@@ -28,6 +28,8 @@ from monopic.pose.sessions import (
     LANDMARK_MODELS,
     RUNTIMES,
     check_runtime,
+    detector_file,
+    landmark_file,
 )
 from monopic.pose.tracker import TrackerConfig
 from monopic.predict.base import Mode
@@ -168,6 +170,16 @@ def run(args: argparse.Namespace) -> int:
         check_runtime(args.runtime)
     except ValueError as err:
         raise UserError(f"--runtime {args.runtime}: {err}") from None
+    for option, value, check in (
+        ("--model", args.model, landmark_file),
+        ("--detector", args.detector, detector_file),
+        ("--window-detector", args.window_detector, detector_file),
+    ):
+        try:
+            if value is not None:
+                check(value)
+        except ValueError as err:
+            raise UserError(f"{option} {value}: {err}") from None
     for option, out in (("--out", args.out), ("--csv", args.csv), ("--rrd", args.rrd)):
         if out is not None:
             output_file(out, option)

@@ -7,6 +7,7 @@ core would fight, so the thread count is always explicit (sweep workers use one)
 from __future__ import annotations
 
 import json
+import platform
 from importlib import resources
 from pathlib import Path
 
@@ -36,23 +37,64 @@ DEFAULT_LANDMARK_MODEL = "full"
 LANDMARK_FILE = LANDMARK_MODELS[DEFAULT_LANDMARK_MODEL]
 
 
+QUANTISED = frozenset({"full-int8", "int8"})
+# The x86 CPU features whose int8 dot products do not saturate: onnxruntime's quantisation
+# guide warns that its u8s8 kernels can saturate on x86 CPUs without VNNI. The shipped
+# int8 files were judged only where one of these is present; on an AVX2 CPU without them
+# the int8 landmark model lost the walker of the test clip in 8 of its first 30 frames
+# that the float model tracked in all 30.
+INT8_SAFE_X86_FLAGS = frozenset({"avx512_vnni", "avx_vnni", "amx_int8"})
+
+
+def x86_cpu_flags() -> frozenset[str] | None:
+    """The CPU's flags from /proc/cpuinfo on an x86 machine; None elsewhere or unreadable."""
+    if platform.machine().lower() not in ("x86_64", "amd64", "i686", "i386"):
+        return None
+    try:
+        text = Path("/proc/cpuinfo").read_text(encoding="utf-8", errors="replace")
+    except OSError:
+        return None
+    for line in text.splitlines():
+        key, _, value = line.partition(":")
+        if key.strip() == "flags":
+            return frozenset(value.split())
+    return None
+
+
+def quantised_unavailable(flags: frozenset[str] | None = None) -> str | None:
+    """Why the int8 models cannot be trusted on this CPU, or None when they can (or when
+    the CPU's flags cannot be read: a machine this project has no figure for)."""
+    flags = x86_cpu_flags() if flags is None else flags
+    if flags is None or flags & INT8_SAFE_X86_FLAGS:
+        return None
+    return (
+        "the int8 models need a CPU with VNNI (AVX512_VNNI, AVX_VNNI or AMX): without it "
+        "onnxruntime's int8 kernels saturate and lose the person; use the float models"
+    )
+
+
 def landmark_file(model: str) -> str:
-    """The shipped file of landmark model `model` (lite, full, heavy or full-int8)."""
+    """The shipped file of landmark model `model` (lite, full, heavy or full-int8).
+
+    ValueError for an unknown name, or for full-int8 on a CPU where it is wrong."""
     return _choice("landmark", LANDMARK_MODELS, model)
 
 
 def detector_file(model: str) -> str:
-    """The shipped file of detector model `model` (float or int8)."""
+    """The shipped file of detector model `model` (float or int8); ValueError as above."""
     return _choice("detector", DETECTOR_MODELS, model)
 
 
 def _choice(kind: str, files: dict[str, str], model: str) -> str:
     try:
-        return files[model]
+        name = files[model]
     except KeyError:
         raise ValueError(
             f"unknown {kind} model {model!r}: choose one of {', '.join(files)}"
         ) from None
+    if model in QUANTISED and (problem := quantised_unavailable()):
+        raise ValueError(f"{kind} model {model!r}: {problem}")
+    return name
 
 
 def model_path(name: str) -> Path:

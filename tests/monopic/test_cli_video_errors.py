@@ -101,3 +101,21 @@ def test_an_unknown_window_detector_is_named_with_the_choices(tmp_path):
     assert r.returncode == 2 and "fp16" in r.stderr and "int8" in r.stderr, r.stderr
     assert len(r.stderr.strip().splitlines()) == 1
     assert list(tmp_path.iterdir()) == []
+
+
+def test_int8_models_on_a_cpu_without_vnni_are_one_line_and_write_nothing(
+    tmp_path, monkeypatch, capsys
+):
+    """Where onnxruntime's int8 kernels saturate, the int8 choices are refused up front
+    (run in-process, so the CPU's flags can be those of an AVX2 machine on any host)."""
+    import monopic.pose.sessions as sessions
+    from monopic.cli.main import main
+
+    monkeypatch.setattr(sessions, "x86_cpu_flags", lambda: frozenset({"avx", "avx2"}))
+    clip = tiny_clip(tmp_path)
+    for option, value in (("--model", "full-int8"), ("--window-detector", "int8")):
+        out = tmp_path / "frames.csv"
+        assert main(["video", str(clip), "--csv", str(out), option, value]) == 2
+        (line,) = capsys.readouterr().err.strip().splitlines()
+        assert line.startswith(f"monopic video: error: {option} {value}: ") and "VNNI" in line
+        assert not out.exists()
