@@ -3,12 +3,12 @@
 from __future__ import annotations
 
 import argparse
-from collections.abc import Callable
+import os
 from pathlib import Path
 
 from tqdm import tqdm
 
-from monopic.cli.args import output_folder
+from monopic.cli.args import output_folder, positive_int
 from monopic.errors import UserError
 
 
@@ -41,39 +41,62 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="the dataset folder (made as needed; an unfinished one of the same spec resumes)",
     )
     p.add_argument(
+        "--workers", type=positive_int, help="local worker processes (default: all cores)"
+    )
+    p.add_argument(
+        "--executor",
+        choices=("local", "ray"),
+        default="local",
+        help="local worker processes, or Ray tasks (extra `ray`; DIR must be a folder every "
+        "node sees at the same path) (default %(default)s)",
+    )
+    p.add_argument("--address", help="Ray cluster address for --executor ray (e.g. host:6379)")
+    p.add_argument(
         "--estimate-only", action="store_true", help="print the size and time estimate and stop"
     )
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim.dataset.build import build, estimate, estimate_duration, finished_runs
+    from sim.commands.sweep import logs_above_the_bar
+    from sim.dataset.build import build, estimate, estimate_duration, finished_runs, work
     from sim.dataset.spec import expand, load_spec
+    from sim.runs.executors import local_executor, ray_executor
 
+    if args.address and args.executor != "ray":
+        raise UserError("--address is for --executor ray")
+    if args.workers and args.executor == "ray":
+        raise UserError("--workers is for --executor local (Ray schedules by the cluster's CPUs)")
     spec = load_spec(args.spec)
     out: Path = args.out
+    # None: a Ray cluster's CPUs, unknown here (the estimate then gives CPU time).
+    workers = None if args.executor == "ray" else (args.workers or os.cpu_count() or 1)
     if args.estimate_only:
         runs = expand(spec)
         done = finished_runs(out, runs) if out.is_dir() else {}
         todo = [r for r in runs if r.id not in done]
         print(f"size: {estimate(runs, list(done.values())).text()}")
-        print(f"time: {estimate_duration(todo, list(done.values())).text()}")
+        print(f"time: {estimate_duration(todo, list(done.values()), workers).text()}")
         return 0
     if out.exists() and not out.is_dir():
         raise UserError(f"--out {out}: is a file, not a dataset folder")
     output_folder(out.parent, "--out")
-    bars: list[tqdm] = []
-
-    def progress(total: int) -> Callable[[int], None]:
-        bar = tqdm(total=total, unit="frame", desc=spec.name)
-        bars.append(bar)
-        return lambda _: bar.update(1)
-
-    try:
-        counts = build(spec, out, report=tqdm.write, progress=progress)
-    finally:
-        for bar in bars:
-            bar.close()
+    if args.executor == "ray":
+        executor = ray_executor(args.address, run=work)
+    else:
+        executor = local_executor(workers, run=work)
+    with logs_above_the_bar(args.executor, args.address):
+        outcome = build(spec, out, executor, workers, report=tqdm.write)
+    if outcome.counts is None:
+        print(
+            f"{len(outcome.failed)} of {outcome.runs} runs failed, {outcome.finished} rendered "
+            f"now, {outcome.skipped} were already there; {out} keeps the finished runs but no "
+            "annotations yet: run the same command to render the failed ones"
+        )
+        for run_id, error in outcome.failed[:3]:
+            print(f"failed {run_id}:\n{error}")
+        return 1
+    counts = outcome.counts
     print(
         f"{counts['runs']} runs, {counts['images']} images, {counts['annotations']} person "
         f"annotations, {counts['feature_rows']} feature rows, {counts['bytes'] / 1e6:.1f} MB "

@@ -24,10 +24,16 @@ visible, box from the mask, visibility 0 outside the image, 1 hidden behind anot
 object, 2 in view; RLE masks), frames.csv (one row per image), runs.csv and README.md
 (the card: what, how, counts, licence).
 
-Deterministic for a spec: the run seeds (the gait phase) are the sweep's, the renderer
-and the pose models are deterministic on one machine; only measured times differ between
-invocations: the features' …Ms columns and each run record's `seconds` (which time
-estimates use).
+The runs execute on the sweep's executors (sim.runs.executors: spawned local workers,
+each keeping its GL context from run to run, or Ray tasks): every run writes its own
+files, its record comes back to this process, and the merge takes the records in the
+spec's order, whichever worker finished first.
+
+Deterministic for a spec, whatever the number of workers: the run seeds (the gait phase)
+are the sweep's, the renderer and the pose models are deterministic on one machine, and
+every run renders in a worker with the same one-thread environment; only measured times
+differ between invocations: the features' …Ms columns and each run record's `seconds`
+(which time estimates use).
 """
 
 from __future__ import annotations
@@ -38,8 +44,9 @@ import json
 import math
 import shutil
 import time
+import traceback
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -63,8 +70,8 @@ from sim.runs.estimate import (
     bench_frame_seconds,
     estimate_time,
 )
-from sim.runs.loop import Listener, LoopFrame, OnBoard, Progress, run_loop
-from sim.runs.sweep import SweepSpec
+from sim.runs.loop import Listener, LoopFrame, OnBoard, run_loop
+from sim.runs.sweep import SweepSpec, run_missing
 from sim.scenario.spec import CameraSpec, Scenario
 from sim.world.ground_truth import GroundTruth
 from sim.world.render import KeptRenderContext
@@ -189,12 +196,7 @@ class FrameWriter(Listener):
         self.truth_lines.append(_truth_line(run, k, image_name, mask_name, truth))
 
 
-def render_run(
-    run: DatasetRun,
-    out: Path,
-    on_frame: Callable[[int], None] | None = None,
-    kept: KeptRenderContext | None = None,
-) -> dict[str, Any]:
+def render_run(run: DatasetRun, out: Path, kept: KeptRenderContext | None = None) -> dict[str, Any]:
     """Render one run into `out`; returns (and writes last) its runs/<id>.json record.
 
     `kept`: a GL context lent from run to run (sim.world.render), else the run makes its own.
@@ -208,13 +210,10 @@ def render_run(
     for sub in ("truth", "features", "runs"):  # a sweep's run ids nest: <scenario>/<draw>-…
         (out / sub / run.id).parent.mkdir(parents=True, exist_ok=True)
     writer = FrameWriter(run, out)
-    listeners: list[Listener] = [writer]
-    if on_frame is not None:
-        listeners.append(Progress(on_frame))
     context = kept.fitting(cam.width, cam.height) if kept is not None else None
     with World(scenario, render=True, render_context=context) as world:
         onboard = OnBoard(FEATURES, dataset_pipeline(scenario))
-        end = run_loop(world, [onboard], listeners, frames=scenario.frames)
+        end = run_loop(world, [onboard], [writer], frames=scenario.frames)
     with atomic_path(out / "truth" / f"{run.id}.jsonl") as tmp:
         tmp.write_text("\n".join(writer.truth_lines) + "\n", encoding="utf-8")
     buf = io.StringIO()
@@ -239,6 +238,30 @@ def render_run(
     record["seconds"] = round(time.perf_counter() - start, 3)  # measured: for time estimates
     write_text_atomically(out / "runs" / f"{run.id}.json", json.dumps(record, default=_plain))
     return record
+
+
+@dataclass(frozen=True)
+class DatasetTask:
+    """One run as a worker receives it: the run and the dataset folder it writes into (a
+    Ray task writes there on its own node: the folder must be the same one on every node)."""
+
+    run: DatasetRun
+    out: Path
+
+    @property
+    def id(self) -> str:  # the executors name a run by its id (a dead worker's, a failure)
+        return self.run.id
+
+
+def work(task: DatasetTask, kept: KeptRenderContext | None = None) -> dict[str, Any]:
+    """One run in a worker: its record, or {"id", "error"} (the other runs go on).
+
+    `kept`: the worker's GL context, lent to the run.
+    """
+    try:
+        return render_run(task.run, task.out, kept)
+    except Exception:  # noqa: BLE001 - reported per run, as a sweep's
+        return {"id": task.id, "error": traceback.format_exc()}
 
 
 def _clipped_box(u0: float, v0: float, u1: float, v1: float, w: int, h: int) -> list[float] | None:
@@ -293,13 +316,16 @@ def estimate(runs: list[DatasetRun], finished: list[dict[str, Any]]) -> SizeEsti
     return SizeEstimate(len(runs), frames, per, False)
 
 
-def estimate_duration(todo: list[DatasetRun], finished: list[dict[str, Any]]) -> TimeEstimate:
-    """The time the runs still to render take (one process renders them, one after another):
-    measured on the finished runs' own times, else the benchmark (sim.runs.estimate)."""
+def estimate_duration(
+    todo: list[DatasetRun], finished: list[dict[str, Any]], workers: int | None
+) -> TimeEstimate:
+    """The time the runs still to render take on `workers` local workers (None: a Ray
+    cluster, CPU time only): per frame as measured on the finished runs' own times (each
+    on one worker), else the benchmark (sim.runs.estimate)."""
     return estimate_time(
         [(r.scenario.frames, bench_frame_seconds(r.scenario.robot.camera, False)) for r in todo],
         [(r["frames"], r.get("seconds", 0.0)) for r in finished],
-        workers=1,
+        workers=workers,
         measured_where="of this dataset",
         start_seconds=DATASET_START_S,
     )
@@ -355,33 +381,76 @@ def prepare_folder(spec: DatasetSpec, out: Path) -> None:
     )
 
 
+Executor = Callable[[Sequence[DatasetTask], Callable[[dict[str, Any]], None]], None]
+
+
+@dataclass(frozen=True)
+class BuildOutcome:
+    """What one invocation did; `counts` (the merged dataset's) only once every run is done."""
+
+    runs: int  # in the spec
+    skipped: int  # finished by an earlier invocation
+    finished: int  # rendered now
+    failed: tuple[tuple[str, str], ...]  # (run id, error), reported per run
+    counts: dict[str, Any] | None  # None: runs failed, nothing merged
+
+
+@dataclass
+class _Records:
+    """Where run_missing hands each finished run's record: checked to be in `out` here,
+    kept by id; the size estimate is redone on the first one."""
+
+    out: Path
+    runs: list[DatasetRun]
+    done: dict[str, dict[str, Any]]
+    size: SizeEstimate
+    report: Callable[[str], None]
+
+    def append(self, record: dict[str, Any]) -> None:
+        if not (self.out / "runs" / f"{record['id']}.json").is_file():
+            raise UserError(
+                f"--out {self.out}: run {record['id']} was rendered where this folder is not "
+                "(a Ray node without it): give a folder every node sees at the same path"
+            )
+        self.done[record["id"]] = record
+        if not self.size.measured:
+            self.size = estimate(self.runs, list(self.done.values()))
+            self.report(f"size, measured on the first run: {self.size.text()}")
+
+
 def build(
     spec: DatasetSpec,
     out: Path,
+    executor: Executor,
+    workers: int | None,
     report: Callable[[str], None] = print,
-    progress: Callable[[int], Callable[[int], None]] | None = None,
-) -> dict[str, Any]:
-    """Render every unfinished run of `spec` into `out`, then merge; returns the counts.
+    progress: bool = True,
+) -> BuildOutcome:
+    """Render every unfinished run of `spec` into `out` on `executor`, then merge.
 
-    `report` gets one-line messages (the size estimate first); `progress(total_frames)`,
-    if given, returns the callback called after every rendered frame (e.g. a bar's update).
+    `workers`: how many runs the executor runs at once, for the time estimate (None: a
+    Ray cluster's, unknown). `report` gets one-line messages (the size estimate first);
+    `progress` shows a bar of finished runs. A failed run is named as it fails and the
+    others go on; the merged files (COCO, frames.csv, runs.csv, the card) are written
+    only when every run is finished, so they never describe a part of the dataset.
     """
     runs = expand(spec)
     prepare_folder(spec, out)
     done = finished_runs(out, runs)
     todo = [r for r in runs if r.id not in done]
+    skipped = len(done)
     size = estimate(runs, list(done.values()))
     report(f"size: {size.text()}")
     report(f"{len(done)} of {len(runs)} runs already finished, {len(todo)} to render")
-    report(f"time: {estimate_duration(todo, list(done.values())).text()}")
-    on_frame = progress(sum(r.scenario.frames for r in todo)) if progress and todo else None
-    with KeptRenderContext() as kept:
-        for run in todo:
-            done[run.id] = render_run(run, out, on_frame, kept)
-            if not size.measured:
-                size = estimate(runs, list(done.values()))
-                report(f"size, measured on the first run: {size.text()}")
-    return merge(spec, out, [done[r.id] for r in runs])
+    report(f"time: {estimate_duration(todo, list(done.values()), workers).text()}")
+
+    tasks = [DatasetTask(r, out.absolute()) for r in todo]  # a Ray worker has its own cwd
+    records = _Records(out, runs, done, size, report)
+    finished, failed = run_missing(tasks, executor, records, spec.name, progress)
+    if failed:
+        return BuildOutcome(len(runs), skipped, finished, tuple(failed), None)
+    counts = merge(spec, out, [done[r.id] for r in runs])
+    return BuildOutcome(len(runs), skipped, finished, (), counts)
 
 
 def merge(spec: DatasetSpec, out: Path, records: list[dict[str, Any]]) -> dict[str, Any]:

@@ -14,7 +14,9 @@ bound: a run ends early at first contact, so collision runs take less. Another m
 or a loaded one, differs: the measured figure replaces the benchmark's as soon as one run
 has finished. Starting costs a fixed time on top, which dominates tiny sweeps: a sweep
 spent 8 s before its first run began (spawning workers that import MuJoCo, onnxruntime
-and the pipeline), a dataset 3 s around its runs (2026-12-01, 2 cores under load 4-5).
+and the pipeline; 2026-12-01, 2 cores under load 4-5). A dataset starts the same workers
+and merges at the end: 5 s beyond its runs' own time on one worker, 6-10 s on two (a
+3-run 384x216 dataset, 2026-12-06, 2 cores under load 3).
 """
 
 from __future__ import annotations
@@ -30,7 +32,7 @@ BENCH_PIPELINE_S = 0.0795 - BENCH_RENDER_S  # pose, features, five predictors, t
 BENCH_ABLATION_S = 0.1012 - 0.0795  # the ground-truth-crop pipeline on the same frame
 BENCH_SOURCE = "the simulator benchmark's 79.5/101.2 ms per 768x432 frame (bench/history.jsonl)"
 SWEEP_START_S = 8.0  # from the command's start to its workers' first runs (measured)
-DATASET_START_S = 3.0  # a dataset's imports, GL context and merge (measured)
+DATASET_START_S = 8.0  # a dataset's workers starting, and its merge (measured)
 
 
 def bench_frame_seconds(camera: CameraSpec, ablation: bool) -> float:

@@ -29,7 +29,7 @@ import zlib
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any
+from typing import Any, Protocol
 
 from tqdm import tqdm
 
@@ -358,13 +358,20 @@ def say_skipped(out: Path, skipped: int, total: int, todo: int) -> None:
           file=sys.stderr)  # fmt: skip
 
 
+class Finished(Protocol):
+    """Where run_missing hands each finished run's row: a results file (ResultsWriter), a
+    dataset's records."""
+
+    def append(self, row: dict[str, Any]) -> None: ...
+
+
 def run_missing(
-    todo: Sequence[Any], executor: Executor, writer: ResultsWriter, desc: str, progress: bool
+    todo: Sequence[Any], executor: Executor, writer: Finished, desc: str, progress: bool
 ) -> tuple[int, list[tuple[str, str]]]:
     """Run `todo` on `executor`, appending each result line to `writer` as it arrives (a
     crash loses no finished run) and naming each failure above the progress bar; returns
-    how many finished and the failures (id, error). The sweep and the Euro NCAP grid both
-    run their runs through here."""
+    how many finished and the failures (id, error). The sweep, the Euro NCAP grid and the
+    dataset all run their runs through here."""
     failed: list[tuple[str, str]] = []
     finished = 0
     with tqdm(

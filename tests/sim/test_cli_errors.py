@@ -254,6 +254,24 @@ def test_record_checks_a_case_as_a_scenario_file_checks_it(
     assert not (tmp_path / "x.rrd").exists()
 
 
+@pytest.mark.parametrize("command", ["sweep", "dataset"])
+@pytest.mark.parametrize(
+    ("options", "expected"),
+    [
+        (["--address", "127.0.0.1:1"], "--address is for --executor ray"),
+        (["--executor", "ray", "--workers", "2"], "--workers is for --executor local (Ray"),
+    ],
+)
+def test_the_executor_options_refuse_what_they_cannot_apply(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str, options: list[str],
+    expected: str,
+) -> None:  # fmt: skip
+    out = tmp_path / ("out" if command == "dataset" else "out.jsonl")
+    assert main([command, str(DEMO), "--out", str(out), *options]) == 2
+    assert expected in one_line_error(capsys)
+    assert not out.exists()
+
+
 def test_ray_log_lines_go_above_the_progress_bar_not_into_it(
     capsys: pytest.CaptureFixture[str],
 ) -> None:
@@ -305,7 +323,7 @@ def test_closed_loop_and_dataset_make_their_output_folders(
     assert main(["dataset", str(spec), "--out", str(out)]) == 0
     assert (out / "README.md").is_file() and (out / "runs").is_dir()
     printed = capsys.readouterr().out
-    assert "time: about 3 s on 1 worker: 3 s to start, then up to 6 frames x " in printed
+    assert "time: about 8 s on 1 worker: 8 s to start, then up to 6 frames x " in printed
 
 
 def test_output_piped_into_a_reader_that_stops_early_ends_quietly() -> None:

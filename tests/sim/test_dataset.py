@@ -6,15 +6,25 @@ from __future__ import annotations
 import csv
 import json
 import shutil
+from dataclasses import replace
 from pathlib import Path
+from typing import Any
 
 import cv2
 import numpy as np
 import pytest
 
+from monopic.cli.main import main
 from monopic.errors import UserError
 from monopic.replay.logs import read_log
-from sim.dataset.build import build
+from sim.dataset.build import (
+    BuildOutcome,
+    DatasetTask,
+    build,
+    estimate_duration,
+    prepare_folder,
+    work,
+)
 from sim.dataset.coco import (
     COCO17_FROM_BLAZEPOSE,
     COCO17_NAMES,
@@ -23,8 +33,11 @@ from sim.dataset.coco import (
     read_coco,
     rle_counts,
 )
-from sim.dataset.spec import expand, load_spec
+from sim.dataset.spec import DatasetSpec, expand, load_spec
+from sim.runs.estimate import DATASET_START_S
+from sim.runs.executors import local_executor, ray_executor, ray_runtime_env
 from sim.world.intent import Intent
+from sim.world.render import KeptRenderContext
 from tests.paths import SCENARIOS
 
 CASE_GRID = SCENARIOS / "datasets" / "case_grid.toml"
@@ -51,12 +64,19 @@ def write_spec(folder: Path, text: str = TINY) -> Path:
     return path
 
 
+def build_on(spec: DatasetSpec, out: Path, workers: int = 1, report=lambda _: None) -> BuildOutcome:
+    """The dataset built as `monopic dataset --workers N` builds it (no progress bar)."""
+    executor = local_executor(workers, run=work)
+    return build(spec, out, executor, workers, report=report, progress=False)
+
+
 @pytest.fixture(scope="module")
 def dataset(tmp_path_factory) -> tuple[Path, Path, dict]:
     folder = tmp_path_factory.mktemp("ds")
     spec = write_spec(folder)
     out = folder / "out"
-    counts = build(load_spec(spec), out, report=lambda _: None)
+    counts = build_on(load_spec(spec), out).counts
+    assert counts is not None
     return spec, out, counts
 
 
@@ -233,7 +253,7 @@ def test_deterministic_and_resumable(dataset, tmp_path):
     (again / "runs" / f"{second}.json").unlink()
     (again / "images" / second / "0003.jpg").unlink()
     messages: list[str] = []
-    build(spec, again, report=messages.append)
+    build_on(spec, again, report=messages.append)
     assert any("1 of 2 runs already finished, 1 to render" in m for m in messages)
     assert comparable(again) == comparable(out)
     for path in sorted((out / "features").rglob("*.csv")):
@@ -242,4 +262,100 @@ def test_deterministic_and_resumable(dataset, tmp_path):
     # Another spec may not write into the same folder.
     other = load_spec(write_spec(tmp_path, TINY.replace("[4.5]", "[4.6]")))
     with pytest.raises(UserError, match="made from another spec"):
-        build(other, again, report=lambda _: None)
+        build_on(other, again)
+
+
+# -- workers -------------------------------------------------------------------------------
+
+
+def test_the_time_estimate_shares_the_runs_among_the_workers(tmp_path, capsys):
+    spec_path = write_spec(tmp_path)
+    runs = expand(load_spec(spec_path))
+    one, two = (estimate_duration(runs, [], workers) for workers in (1, 2))
+    assert one.seconds is not None and two.seconds is not None
+    assert two.seconds - DATASET_START_S == pytest.approx((one.seconds - DATASET_START_S) / 2)
+    assert estimate_duration(runs, [], None).seconds is None  # a Ray cluster: CPU time only
+    out = tmp_path / "out"
+    assert main(["dataset", str(spec_path), "--out", str(out), "--estimate-only",
+                 "--workers", "2"]) == 0  # fmt: skip
+    assert f"time: about {two.seconds:.0f} s on 2 workers:" in capsys.readouterr().out
+    assert not out.exists()
+
+
+def _names(folder: Path) -> list[str]:
+    return sorted(str(p.relative_to(folder)) for p in folder.rglob("*") if p.is_file())
+
+
+@pytest.mark.slow
+def test_one_or_two_workers_make_the_same_dataset_file_by_file(dataset, tmp_path):
+    # The fixture's two runs rendered one after the other in one worker, on one GL
+    # context; here each has a worker of its own and they finish in either order.
+    spec_path, out, _ = dataset
+    two = tmp_path / "two"
+    assert main(["dataset", str(spec_path), "--out", str(two), "--workers", "2"]) == 0
+    assert _names(two) == _names(out)
+    # Byte for byte (JPEG encoding included): images, masks, truth, COCO files, frames.csv;
+    # less the measured times (features' …Ms columns, run seconds) and the byte counts.
+    assert comparable(two) == comparable(out)
+    for path in sorted((out / "features").rglob("*.csv")):
+        assert _without_timing(path) == _without_timing(two / path.relative_to(out))
+
+
+@pytest.mark.slow
+def test_a_failed_run_is_named_the_others_finish_and_the_same_command_completes_it(
+    dataset, tmp_path, capsys
+):
+    spec_path, out, _ = dataset
+    spec = load_spec(spec_path)
+    first, second = (r.id for r in expand(spec))
+    again = tmp_path / "again"
+    prepare_folder(spec, again)
+    blocker = again / "images" / first  # a file where the run makes its image folder
+    blocker.parent.mkdir(parents=True)
+    blocker.write_text("")
+    argv = ["dataset", str(spec_path), "--out", str(again), "--workers", "2"]
+    assert main(argv) == 1
+    printed = capsys.readouterr().out
+    assert f"run {first} failed: FileExistsError: " in printed
+    assert "1 of 2 runs failed, 1 rendered now, 0 were already there" in printed
+    assert (again / "runs" / f"{second}.json").is_file()
+    assert not (again / "runs" / f"{first}.json").exists()
+    assert not any((again / "annotations").iterdir())  # nothing merged from half a dataset
+    assert not (again / "frames.csv").exists() and not (again / "README.md").exists()
+    blocker.unlink()
+    assert main(argv) == 0
+    assert "1 of 2 runs already finished, 1 to render" in capsys.readouterr().out
+    assert comparable(again) == comparable(out)
+
+
+def work_on_another_node(task: DatasetTask, kept: KeptRenderContext | None) -> dict[str, Any]:
+    """A worker that sees another folder at the dataset's path (a Ray node without a shared
+    folder): it writes beside the dataset instead."""
+    return work(replace(task, out=task.out.with_name(task.out.name + "-node")), kept)
+
+
+@pytest.mark.slow
+def test_runs_rendered_where_the_dataset_folder_is_not_stop_the_build_in_one_line(tmp_path):
+    spec = load_spec(write_spec(tmp_path))
+    out = tmp_path / "out"
+    executor = local_executor(1, run=work_on_another_node)
+    with pytest.raises(UserError) as err:
+        build(spec, out, executor, 1, report=lambda _: None, progress=False)
+    assert str(err.value).startswith(f"--out {out.absolute()}: run {expand(spec)[0].id} was "
+                                      "rendered where this folder is not")  # fmt: skip
+    assert (tmp_path / "out-node" / "runs").is_dir() and not any((out / "runs").iterdir())
+
+
+@pytest.mark.slow
+def test_ray_tasks_make_the_same_dataset(dataset, tmp_path):
+    ray = pytest.importorskip("ray", reason="Ray is not installed (the optional [ray] extra)")
+    spec_path, out, _ = dataset
+    on_ray = tmp_path / "ray"
+    ray.init(num_cpus=2, include_dashboard=False, runtime_env=ray_runtime_env())
+    try:
+        outcome = build(load_spec(spec_path), on_ray, ray_executor(None, run=work), None,
+                        report=lambda _: None, progress=False)  # fmt: skip
+    finally:
+        ray.shutdown()
+    assert outcome.finished == 2 and not outcome.failed
+    assert comparable(on_ray) == comparable(out)

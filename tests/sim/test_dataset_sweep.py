@@ -13,13 +13,14 @@ import pytest
 
 from monopic.cli.main import main
 from monopic.errors import UserError
-from sim.dataset.build import build, prepare_folder
+from sim.dataset.build import prepare_folder
 from sim.dataset.spec import expand, load_spec
 from sim.runs import sweep
 from tests.paths import SCENARIOS
 from tests.sim.test_dataset import (
     _without_timing,
     assert_pycocotools_reads_what_our_reader_reads,
+    build_on,
     comparable,
 )
 
@@ -176,7 +177,7 @@ def test_a_sweep_form_dataset_resumes_with_the_same_files(sweep_dataset, tmp_pat
     (again / "runs" / f"{second}.json").unlink()
     (again / "images" / second / "0003.jpg").unlink()
     messages: list[str] = []
-    build(spec, again, report=messages.append)
+    build_on(spec, again, report=messages.append)
     assert any("1 of 2 runs already finished, 1 to render" in m for m in messages)
     assert comparable(again) == comparable(out)  # the same images, masks, truth, COCO
     for path in sorted((out / "features").rglob("*.csv")):
@@ -195,4 +196,4 @@ def test_an_edited_scenario_file_makes_another_dataset(tmp_path: Path) -> None:
     edited = (cases / copied.name).read_text().replace("distance = 8.0", "distance = 9.0")
     (cases / copied.name).write_text(edited)
     with pytest.raises(UserError, match="made from another spec"):
-        build(load_spec(path), out, report=lambda _: None)
+        build_on(load_spec(path), out)

@@ -2,8 +2,8 @@
 
 Stopping: a sweep stopped by SIGINT (sent to its process group, as a terminal's Ctrl-C
 is) or SIGTERM, while its workers spawn, mid-run or during its last run, exits within
-5 s with its one line and exit code (130, 143), and so do `monopic dataset` and
-`monopic closed-loop`; a worker that ignores its SIGTERM is killed after the grace.
+5 s with its one line and exit code (130, 143), and so do `monopic dataset` (its workers
+gone too) and `monopic closed-loop`; a worker that ignores its SIGTERM is killed after the grace.
 Dead workers and killed sweeps: a worker SIGKILLed mid-run has its run done again; a
 run that kills its worker every time is reported failed and the sweep goes on; a sweep
 SIGKILLed and resumed loses no finished run and gets the same results.
@@ -429,13 +429,23 @@ def test_dataset_and_closed_loop_stop_within_seconds_with_their_line(
     sig: int, code: int, word: str, four: Path, tmp_path: Path, commands: list[Command]
 ) -> None:
     folder = tmp_path / "ds"
-    dataset = Command.start(["dataset", str(four), "--out", str(folder)], tmp_path, "dataset")
+    dataset = Command.start(
+        ["dataset", str(four), "--out", str(folder), *SWEEP_FLAGS], tmp_path, "dataset"
+    )
     commands.append(dataset)
-    dataset.wait_for(lambda: any((folder / "runs").rglob("*.json")), "a finished run")
+    workers: set[int] = set()
+
+    def a_finished_run() -> bool:
+        workers.update(dataset.workers())
+        return any((folder / "runs").rglob("*.json"))
+
+    dataset.wait_for(a_finished_run, "a finished run")
+    assert len(workers) == 2  # the runs render on two spawned workers
     seconds = dataset.stop(sig)
     assert seconds < STOP_BOUND_S and dataset.proc.returncode == code
     assert dataset.last_line() == f"monopic dataset: {word}"
     assert "Traceback" not in dataset.text()
+    assert gone_within(workers, STOP_BOUND_S), "a dataset worker lives on"
 
     scenario = sweep_spec(tmp_path, "loop", speeds(1), duration=3.0).with_name("loop.toml")
     loop = Command.start(
