@@ -9,8 +9,9 @@ world, topdown, truth, ttc, alarm, robot):
 - features/{phi,vx,vy}     time series; latency/{stage} per-stage milliseconds
 - events                   the warning's onset and end, each line starting with its time
 Frames are indexed on the `frame` timeline and on `time` (seconds of the stream).
-The file appears whole or not at all: it is written under a temporary name and renamed
-by `close()`.
+The file appears whole or not at all: it is written under a temporary name (monopic.output)
+and renamed by `close()`; `abort()`, or a failed `close()`, deletes it, and a killed
+writer's temporary of the same file is deleted when the file is started again.
 
 Colours say who is speaking: the pipeline's estimates (skeleton, phi, the primary
 predictor's point and path) are pink, each predictor has its own colour
@@ -37,7 +38,7 @@ import rerun.blueprint as rrb
 import rerun_bindings
 
 from monopic.closing import WholeOrNothing
-from monopic.output import temporary_sibling
+from monopic.output import remove_stale_temporaries, temporary_sibling
 from monopic.pipeline import FrameResult
 from monopic.pose.skeleton import CONNECTIONS, LANDMARK_NAMES
 
@@ -188,6 +189,7 @@ class RunRecording(WholeOrNothing):
         )
         self._blueprint.set_time("blueprint", sequence=0)
         layout.to_blueprint()._log_to_stream(self._blueprint)  # noqa: SLF001
+        remove_stale_temporaries(self.path.parent, output=self.path)
         rerun_bindings.save(
             path=str(self.tmp),
             default_blueprint=self._blueprint.memory_recording().storage,
@@ -276,17 +278,24 @@ class RunRecording(WholeOrNothing):
                 rec.log(f"latency/{stage}", rr.Scalars(result.stage_ms[stage]))
 
     def close(self) -> None:
-        """Flush and move the finished file into place."""
-        if not self.started:
-            self.start(blueprint())
-        self.rec.flush()
-        self._release()
-        os.replace(self.tmp, self.path)
+        """Flush and move the finished file into place (or, if that fails or is
+        interrupted, delete it)."""
+        try:
+            if not self.started:
+                self.start(blueprint())
+            self.rec.flush()
+            self._release()
+            os.replace(self.tmp, self.path)
+        except BaseException:
+            self.tmp.unlink(missing_ok=True)
+            raise
 
     def abort(self) -> None:
         """Drop the partial recording."""
-        self._release()
-        self.tmp.unlink(missing_ok=True)
+        try:
+            self._release()
+        finally:
+            self.tmp.unlink(missing_ok=True)
 
     def _release(self) -> None:
         """Free the stream's native side. rerun 0.41 keeps a dropped stream's batcher

@@ -20,6 +20,7 @@ from tests.paths import ROOT
 HEAVY = ("mujoco", "highway_env", "gymnasium", "pygame")
 # Modules that must load without the simulator's heavy packages.
 LIGHT = (
+    "sim",  # registers the gymnasium environment only when gymnasium is loaded already
     "sim.geometry.frames",
     "sim.geometry.polygons",
     "sim.scenario.spec",
@@ -96,9 +97,10 @@ def test_light_modules_load_no_heavy_package(module):
     assert out.stdout.strip() == "", f"{module} loads {out.stdout.strip()}"
 
 
-def test_the_environment_registers_without_loading_the_world():
+@pytest.mark.parametrize("registers", ["sim.envs", "sim"])  # `import sim` after gymnasium
+def test_the_environment_registers_without_loading_the_world(registers):
     code = (
-        "import sys, gymnasium, sim.envs\n"
+        f"import sys, gymnasium, {registers}\n"
         "assert 'monopic/PedestrianCrossing-v0' in gymnasium.registry\n"
         "print(','.join(m for m in ('mujoco', 'highway_env', 'pygame') if m in sys.modules))"
     )

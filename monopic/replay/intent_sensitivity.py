@@ -23,7 +23,7 @@ from typing import Any
 import numpy as np
 
 from monopic.errors import UserError
-from monopic.output import write_text_atomically
+from monopic.output import atomic_path, write_text_atomically
 from monopic.replay.intent_training import (
     RunCount,
     RunRows,
@@ -259,10 +259,9 @@ def plot(s: Sensitivity, path: Path) -> None:
     axes[0][0].legend(fontsize=8)
     fig.suptitle(f"Ground intent tree against constant velocity, {s.runs} replayed runs")
     fig.tight_layout()
-    tmp = path.with_name(path.name + ".tmp.png")
-    fig.savefig(tmp, dpi=90)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=90)
     plt.close(fig)
-    tmp.replace(path)
 
 
 def write(s: Sensitivity, out_dir: Path, sources: Sequence[str]) -> Path:

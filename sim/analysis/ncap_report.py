@@ -20,6 +20,7 @@ from typing import Any
 
 import numpy as np
 
+from monopic.output import atomic_path
 from sim.analysis.ncap_score import CalculatorScore, Cell, band_colour, percent
 from sim.runs.ncap_grid import GRID, NEAR_MISS, VERIFY
 from sim.scenario.ncap import Protocol
@@ -191,7 +192,8 @@ def plot_matrices(
         fontsize=9,
     )
     fig.tight_layout()
-    fig.savefig(out, dpi=110)
+    with atomic_path(out) as tmp:
+        fig.savefig(tmp, dpi=110, format="png")
     plt.close(fig)
 
 

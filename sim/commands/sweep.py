@@ -11,6 +11,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from monopic.cli.args import output_file, positive_int
+from monopic.output import is_temporary
 
 if TYPE_CHECKING:  # the simulator is imported when the command runs
     from sim.runs.run_spec import RunSpec
@@ -153,14 +154,15 @@ def kept_recordings(folder: Path, record: str) -> str:
     """What the recordings folder holds, once the folders of dropped recordings are gone.
 
     Each run makes its family's folder before it knows whether its recording is kept;
-    the empty ones are removed here, after the workers have finished."""
+    the empty ones are removed here, after the workers have finished. A recording still
+    being written (a temporary of another sweep sharing the folder) is not one kept."""
     if folder.is_dir():
         for sub in sorted(folder.rglob("*"), key=lambda p: len(p.parts), reverse=True):
             if sub.is_dir() and not any(sub.iterdir()):
                 sub.rmdir()
         if not any(folder.iterdir()):
             folder.rmdir()
-    kept = sorted(folder.rglob("*.rrd")) if folder.is_dir() else []
+    kept = [p for p in folder.rglob("*.rrd") if not is_temporary(p)] if folder.is_dir() else []
     which = "missed collisions and false alarms" if record == "failed" else "every run"
     if not kept:
         return f"recordings ({which}): none kept"

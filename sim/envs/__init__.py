@@ -2,8 +2,20 @@
 
 Importing this package registers the environment with gymnasium and loads nothing else:
 gymnasium imports `sim.envs.crossing` (MuJoCo, highway-env, pygame) on the first
-`gymnasium.make`, as highway-env registers its own environments. Without importing it,
-`gymnasium.make("sim.envs:monopic/PedestrianCrossing-v0")` imports it for you.
+`gymnasium.make`, as highway-env registers its own environments. gymnasium 1.x has no
+plug-in discovery, so it must be imported; three ways, each tested in tests/sim/test_env.py:
+
+    gym.make("sim.envs:monopic/PedestrianCrossing-v0")  # gymnasium imports sim.envs
+
+    import gymnasium as gym, sim  # gymnasium first: `import sim` registers it then
+    gym.make("monopic/PedestrianCrossing-v0")
+
+    import sim.envs  # any time
+    gym.make("monopic/PedestrianCrossing-v0")
+
+The scenario is the config's "scenario": a sim.scenario.spec.Scenario or a scenario
+file's path, e.g. `config={"scenario": "scenarios/families/small/cpna25.toml"}`
+(sim.envs.crossing).
 """
 
 from __future__ import annotations

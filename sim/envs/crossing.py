@@ -17,8 +17,12 @@ viewer) whose dynamics are exactly World.step: one world step per simulation fra
 - render modes: "rgb_array" returns the camera frame, "top_down" highway-env's bird's-eye
   view drawn offscreen.
 
-The config key "scenario" holds a sim.scenario.spec.Scenario (default:
-sim.scenario.cases.default_crossing).
+The config key "scenario" holds a sim.scenario.spec.Scenario or a scenario file's path (a
+str or pathlib.Path: its base scenario, the file without its sweep, as `monopic record FILE`
+runs it); default sim.scenario.cases.default_crossing. A path is read when the env is
+configured (made, or reset with options={"config": ...}), and env.config then holds its
+Scenario; a missing or bad file is a monopic.errors.UserError naming the file and the field,
+as the commands report it.
 Each reset draws the world's seed (the gait phase) from the env's RNG, so a seeded reset is
 deterministic. Simulation and policy frequency default to 15 Hz; `metadata["render_fps"]`
 is the rate frames are rendered at, one per step (highway-env doubles it, which would
@@ -34,6 +38,7 @@ from __future__ import annotations
 
 import math
 import os
+from pathlib import Path
 
 import gymnasium
 import numpy as np
@@ -43,11 +48,29 @@ from highway_env.envs.common.action import ActionType
 from highway_env.envs.common.graphics import EnvViewer
 from highway_env.envs.common.observation import ObservationType
 
+from monopic.errors import UserError
 from sim.scenario.cases import default_crossing
+from sim.scenario.files import load
 from sim.scenario.spec import Scenario
 from sim.world.ground_truth import pedestrian_passed
 from sim.world.robot import Robot
 from sim.world.world import World, WorldStep
+
+
+def scenario_of(value: object) -> Scenario | None:
+    """The config's "scenario" as a Scenario (None: the default crossing).
+
+    A str or os.PathLike is a scenario file: its base scenario (sim.scenario.files.load,
+    whose UserError names the file and the bad field).
+    """
+    if value is None or isinstance(value, Scenario):
+        return value
+    if isinstance(value, str | os.PathLike):
+        return load(Path(value)).base
+    raise UserError(
+        f'config["scenario"] = {value!r}: expected a sim.scenario.spec.Scenario or a '
+        "scenario file's path (str or pathlib.Path)"
+    )
 
 
 class CameraObservation(ObservationType):
@@ -119,7 +142,7 @@ class PedestrianCrossingEnv(AbstractEnv):
     Reward: `progress_reward` per metre driven, `contact_reward` on contact.
     Episode: terminated on contact or once the pedestrian is behind the robot, truncated
     at the scenario's duration; info holds the ground truth and the robot's state.
-    Config: "scenario" (a sim.scenario.spec.Scenario; default
+    Config: "scenario" (a sim.scenario.spec.Scenario or a scenario file's path; default
     sim.scenario.cases.default_crossing), the frequencies (15 Hz) and highway-env's
     viewer keys. Render modes: "rgb_array" (the camera frame), "top_down" (highway-env's
     bird's-eye view), at `metadata["render_fps"]` = the policy frequency.
@@ -144,12 +167,19 @@ class PedestrianCrossingEnv(AbstractEnv):
         steps = "simulation_frequency" if self._record_video_wrapper else "policy_frequency"
         self.metadata = {**type(self).metadata, "render_fps": self.config[steps]}
 
+    def configure(self, config: dict | None) -> None:
+        """highway-env's configure, with "scenario" read at once (a path becomes the
+        file's Scenario): a bad value fails here, saying why, rather than somewhere inside
+        highway-env when the scenario is first used."""
+        super().configure(config)
+        self.config["scenario"] = scenario_of(self.config["scenario"])
+
     @classmethod
     def default_config(cls) -> dict:
         config = super().default_config()
         config.update(
             {
-                "scenario": None,  # a Scenario; None: sim.scenario.cases.default_crossing()
+                "scenario": None,  # None: sim.scenario.cases.default_crossing() (scenario_of)
                 "observation": {"type": "camera"},
                 "action": {"type": "acceleration"},
                 "simulation_frequency": 15,

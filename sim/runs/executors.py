@@ -10,7 +10,10 @@ fresh one costs about 0.2 s of shader compilation per run on llvmpipe).
 Stopping is bounded: a stopped sweep (Ctrl-C, SIGTERM, an error) sends its workers
 SIGTERM, gives them STOP_GRACE_S to exit and then SIGKILLs the rest; a worker that dies
 mid-run (killed, out of memory) has its run given once more to a fresh worker and, if
-that dies too, reported as failed while the sweep goes on.
+that dies too, reported as failed while the sweep goes on. A worker stopped so deletes
+nothing: the temporary file it was writing is the caller's to clear once `execute`
+returns, its workers gone (monopic.output.stale_temporaries_cleared, as sim.runs.sweep
+does for its recordings).
 """
 
 from __future__ import annotations

@@ -129,9 +129,16 @@ def run(
             listeners.append(Recorder(recording))
         if on_frame is not None:
             listeners.append(Progress(on_frame))
-        end = run_loop(
-            world, onboard, listeners, frames=scenario.frames, stop_at_contact=spec.stop_at_contact
-        )
+        try:
+            end = run_loop(
+                world, onboard, listeners, frames=scenario.frames,
+                stop_at_contact=spec.stop_at_contact,
+            )  # fmt: skip
+        except BaseException:
+            # A failed run is reported and the worker goes on: its partial recording goes.
+            if recording is not None:
+                recording.abort()
+            raise
         if recording is not None:
             if spec.record == "all" or recording.went_wrong():
                 recording.close()

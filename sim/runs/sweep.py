@@ -34,6 +34,7 @@ from typing import Any, Protocol
 from tqdm import tqdm
 
 from monopic.errors import UserError
+from monopic.output import stale_temporaries_cleared
 from sim.runs.code_version import code_version
 from sim.runs.result import SCHEMA
 from sim.runs.results_file import ResultsWriter, scan
@@ -292,6 +293,9 @@ def run_sweep(
     runs keep a .rrd recording in `record_dir` (default: beside the results file).
     A results file holding runs of other code (sim.runs.code_version) is not resumed: that
     is an error, or with `restart` the file and its recordings are set aside first.
+    The recordings folder is cleared of stale temporaries (monopic.output) before the runs
+    start and after the workers are gone, however the sweep ends: a worker stopped
+    mid-run dies without deleting the recording it was writing.
     """
     code = sweep_code(spec)
     runs = expand_spec(spec)
@@ -331,7 +335,10 @@ def run_sweep(
     elif other or newer:
         tag = other.most_common(1)[0][0] if other and len(other) == 1 else "mixed"
         set_aside(out, folder, tag if other else f"schema{newer[1]}")
-    with ResultsWriter(out) as writer:
+    # The lock held, no other sweep of this results file writes recordings: the
+    # temporaries found in its folder are a killed sweep's, or being written by a sweep
+    # of another results file sharing the folder (its processes run: kept).
+    with ResultsWriter(out) as writer, stale_temporaries_cleared(folder):
         if record != "none":
             try:
                 folder.mkdir(parents=True, exist_ok=True)

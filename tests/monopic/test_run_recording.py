@@ -20,6 +20,24 @@ def test_recording_appears_only_when_the_run_ends_without_an_error(tmp_path: Pat
     assert sorted(p.name for p in tmp_path.iterdir()) == ["good.rrd"]  # no temporary left
 
 
+def test_a_close_interrupted_before_the_rename_leaves_no_temporary(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Ctrl-C while the finished file is flushed: neither the file nor its temporary stays.
+    rec = RunRecording(tmp_path / "run.rrd")
+    rec.rec.log("features/phi", rr.Scalars(1.0))
+    release = rec._release
+
+    def interrupted() -> None:
+        release()
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(rec, "_release", interrupted)
+    with pytest.raises(KeyboardInterrupt):
+        rec.close()
+    assert list(tmp_path.iterdir()) == []
+
+
 def _threads() -> int:
     """This process's threads once the short-lived ones are gone: the fewest seen over
     0.3 s (rerun's flush threads end a moment after a recording closes; a full-suite run

@@ -2,8 +2,11 @@
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import warnings
 from dataclasses import replace
+from pathlib import Path
 
 import gymnasium as gym
 import numpy as np
@@ -11,10 +14,13 @@ import pytest
 from gymnasium.utils.env_checker import check_env
 
 from monopic.cases import Case
+from monopic.errors import UserError
 from sim.envs import ENV_ID
 from sim.envs.crossing import PedestrianCrossingEnv
 from sim.scenario.cases import CasePlacement, default_crossing
+from sim.scenario.files import load
 from sim.scenario.spec import CameraSpec, RoadLayout, Scenario
+from tests.paths import ROOT
 
 SMALL = CameraSpec(width=160, height=90)
 
@@ -216,3 +222,126 @@ def test_top_down_view_is_drawn_under_the_dummy_video_driver(
         assert p_col > r_col + 80  # 6 m east (ahead)
     finally:
         env.close()
+
+
+# A user's own scenario file: a case-5 crossing, small camera, no buildings.
+MY_SCENARIO = """
+name = "my-crossing"
+kind = "collision"
+scale = "small"
+duration = 1.0
+[robot]
+speed = 1.5
+[robot.camera]
+width = 160
+height = 90
+[pedestrian]
+speed = {speed}
+[path]
+kind = "case"
+case = 5
+distance = 3.0
+[scene.road]
+buildings = false
+"""
+
+
+def my_scenario(folder: Path, speed: float = 1.4) -> Path:
+    path = folder / "my-crossing.toml"
+    path.write_text(MY_SCENARIO.format(speed=speed))
+    return path
+
+
+@pytest.mark.parametrize("as_path", [str, Path], ids=["str", "Path"])
+def test_a_scenario_file_path_in_the_config_runs_its_base_scenario(
+    tmp_path: Path, as_path: type
+) -> None:
+    path = my_scenario(tmp_path)
+    env = make(scenario=as_path(path))
+    try:
+        assert env.scenario == load(path).base and env.config["scenario"] == env.scenario
+        obs, _ = env.reset(seed=0)
+        assert obs.shape == (90, 160, 3)
+        _, _, _, _, info = env.step(np.array([0.0], dtype=np.float32))
+        assert info["speed"] == pytest.approx(1.5)  # the file's robot speed
+        # Another file on reset, as highway-env's options={"config": ...} allows.
+        other = tmp_path / "other.toml"
+        other.write_text(path.read_text().replace("speed = 1.5", "speed = 0.5"))
+        env.reset(seed=0, options={"config": {"scenario": other}})
+        assert env.scenario == load(other).base and env.world.scenario == env.scenario
+    finally:
+        env.close()
+
+
+def test_a_bad_scenario_in_the_config_is_one_clear_error(tmp_path: Path) -> None:
+    missing = tmp_path / "missing.toml"
+    bad = my_scenario(tmp_path, speed=-1.0)
+    with pytest.raises(UserError) as expected:
+        load(bad)  # what `monopic record` says of the same file
+    assert str(expected.value).startswith(f"{bad}: pedestrian.speed = -1.0: ")
+    spec = ROOT / "scenarios" / "sweeps" / "demo.toml"
+    cases = [
+        (str(missing), f"{missing}: no such scenario file"),
+        (bad, str(expected.value)),
+        (spec, f"{spec}: this is a sweep spec, not a scenario file (it lists scenario files "
+         f"under [[include]]): run it with `monopic sweep {spec}`"),
+        (3, 'config["scenario"] = 3: expected a sim.scenario.spec.Scenario or a scenario '
+         "file's path (str or pathlib.Path)"),
+    ]  # fmt: skip
+    for value, message in cases:
+        with pytest.raises(UserError) as info:
+            gym.make(ENV_ID, config={"scenario": value})
+        assert str(info.value) == message
+
+
+MAKE_IN_A_FRESH_PYTHON = """
+import sys
+{imports}
+env = gym.make({env_id!r}, config={{"scenario": sys.argv[1]}}, render_mode="rgb_array")
+obs, _ = env.reset(seed=0)
+print(obs.shape)
+env.close()
+"""
+
+
+@pytest.mark.parametrize(
+    ("imports", "env_id"),
+    [
+        ("import gymnasium as gym", f"sim.envs:{ENV_ID}"),  # gymnasium imports sim.envs
+        ("import gymnasium as gym, sim", ENV_ID),  # `import sim` registers it
+    ],
+    ids=["module-prefix", "import-sim"],
+)
+def test_made_without_importing_sim_envs(imports: str, env_id: str, tmp_path: Path) -> None:
+    # gymnasium 1.x has no plug-in discovery: without one of these, gymnasium answers
+    # "Namespace monopic not found. Have you installed the proper package for monopic?"
+    code = MAKE_IN_A_FRESH_PYTHON.format(imports=imports, env_id=env_id)
+    result = subprocess.run(
+        [sys.executable, "-c", code, str(my_scenario(tmp_path))],
+        capture_output=True, text=True, cwd=tmp_path, timeout=300,
+    )  # fmt: skip
+    assert result.returncode == 0, result.stderr[-1500:]
+    assert result.stdout.strip() == "(90, 160, 3)"
+
+
+def test_import_sim_before_gymnasium_registers_nothing() -> None:
+    # The order the docs give matters: registering it here would mean importing gymnasium,
+    # which `import sim` must not load.
+    code = (
+        "import sys, sim, gymnasium\n"
+        "print('gymnasium' in sys.modules, 'monopic/PedestrianCrossing-v0' in gymnasium.registry)"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    assert result.stdout.split() == ["True", "False"], result.stderr[-1500:]
+
+
+def test_the_readme_example_runs_as_written() -> None:
+    readme = (ROOT / "README.md").read_text()
+    blocks = [b.split("```", 1)[0] for b in readme.split("```python\n")[1:]]
+    (example,) = [b for b in blocks if "sim.envs:monopic/PedestrianCrossing-v0" in b]
+    assert 'config={"scenario": "scenarios/' in example  # it shows a scenario file
+    code = example + "\nprint(obs.shape == env.observation_space.shape)\nenv.close()\n"
+    result = subprocess.run(
+        [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=300
+    )
+    assert result.stdout.strip() == "True", result.stderr[-1500:]

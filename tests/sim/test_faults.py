@@ -3,10 +3,14 @@
 Stopping: a sweep stopped by SIGINT (sent to its process group, as a terminal's Ctrl-C
 is) or SIGTERM, while its workers spawn, mid-run or during its last run, exits within
 5 s with its one line and exit code (130, 143), and so do `monopic dataset` (its workers
-gone too) and `monopic closed-loop`; a worker that ignores its SIGTERM is killed after the grace.
+gone too), `monopic closed-loop` and `monopic record`, leaving no temporary file (the
+sweep's workers die mid-recording: the sweep deletes theirs); a worker that ignores its
+SIGTERM is killed after the grace.
 Dead workers and killed sweeps: a worker SIGKILLed mid-run has its run done again; a
 run that kills its worker every time is reported failed and the sweep goes on; a sweep
-SIGKILLed and resumed loses no finished run and gets the same results.
+SIGKILLed and resumed loses no finished run and gets the same results, and its
+temporaries are removed by the next run, not those of a process that still runs; a run
+that fails drops its partial recording.
 Files: a torn last line resumes, a corrupt middle line is refused with its number; no
 space left while appending, a read-only folder, results of a newer schema and a second
 sweep on the same file each end in one clear line; an unreachable Ray address too,
@@ -38,6 +42,7 @@ import pytest
 
 from monopic.cli.main import main
 from monopic.errors import UserError
+from monopic.output import host_tag
 from sim.runs.code_version import code_version
 from sim.runs.executors import WORKER_ENV, local_executor, work
 from sim.runs.result import RunResult
@@ -46,6 +51,7 @@ from sim.runs.run_spec import RunSpec
 from sim.runs.sweep import expand_spec, load_spec, run_sweep
 from sim.world.render import KeptRenderContext
 from tests.paths import ROOT
+from tests.processes import dead_pid, live_pid
 
 # A 6-frame crossing (case 5) on a 256x144 camera without buildings: about a second a run.
 SCENARIO = """
@@ -251,6 +257,11 @@ def by_id(path: Path) -> dict[str, dict]:
     return {r.id: r.deterministic() for r in rows}
 
 
+def temporaries(folder: Path) -> list[Path]:
+    """Every temporary file under `folder` (monopic.output names them NAME.PID@HOST.tmp...)."""
+    return sorted(p for p in folder.rglob("*") if ".tmp" in p.name)
+
+
 SWEEP_FLAGS = ["--workers", "2"]
 SIGNALS = [
     pytest.param(signal.SIGINT, 130, "interrupted", id="SIGINT"),
@@ -335,6 +346,89 @@ def test_every_stop_ends_the_sweep_within_seconds_with_its_line(
             assert "Traceback" not in sweep.text(), where
             assert gone_within(workers, STOP_BOUND_S), f"{where}: a worker lives on"
             whole_lines(out)
+            assert not temporaries(tmp_path), f"{where}: {temporaries(tmp_path)}"
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(("sig", "code", "word"), SIGNALS)
+def test_a_sweep_stopped_mid_run_leaves_no_temporary_file(
+    sig: int, code: int, word: str, many: Path, tmp_path: Path, commands: list[Command]
+) -> None:
+    # Its workers die of their SIGTERM (or SIGKILL) in the middle of a recording, without
+    # deleting its temporary: the sweep deletes what they leave.
+    out = tmp_path / "x.jsonl"
+    args = ["sweep", str(many), "--out", str(out), "--record", "all", *SWEEP_FLAGS]
+    sweep = Command.start(args, tmp_path)
+    commands.append(sweep)
+    folder = tmp_path / "x_rrd"
+    sweep.wait_for(lambda: lines(out) >= 1 and bool(temporaries(folder)), "a run recording")
+    workers = sweep.workers()
+    sweep.stop(sig)
+    assert sweep.proc.returncode == code and sweep.last_line() == f"monopic sweep: {word}"
+    assert gone_within(workers, STOP_BOUND_S)
+    assert temporaries(tmp_path) == []
+    assert len(list(folder.rglob("*.rrd"))) >= 1  # the finished runs' recordings stay
+
+
+@pytest.mark.slow
+def test_the_temporaries_of_a_killed_sweep_are_removed_by_the_next_run(
+    tmp_path: Path, commands: list[Command], capsys: pytest.CaptureFixture[str]
+) -> None:
+    # SIGKILL gives nobody a chance to clean: the next sweep on the same results does.
+    spec_path = sweep_spec(tmp_path, "two", '"duration" = [0.4, 4.0]', speed=0.0)
+    out = tmp_path / "killed.jsonl"
+    args = ["sweep", str(spec_path), "--out", str(out), "--record", "all", *SWEEP_FLAGS]
+    sweep = Command.start(args, tmp_path, "killed")
+    commands.append(sweep)
+    folder = tmp_path / "killed_rrd"
+    sweep.wait_for(lambda: lines(out) >= 1 and bool(temporaries(folder)), "the second recording")
+    sweep.kill()  # the sweep and its workers (one process group)
+    assert temporaries(folder), "no temporary was left: nothing was tested"
+    assert main(args) == 0
+    assert temporaries(tmp_path) == []
+    assert capsys.readouterr().out.splitlines()[-1] == f"recordings (every run): 2 in {folder}"
+
+
+def test_stale_temporaries_go_live_ones_stay_and_only_recordings_are_counted(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # A killed sweep's temporaries (of runs it will not redo, as after --limit) go
+    # when the next sweep on the same results starts; one whose process runs (another
+    # sweep sharing --recordings) stays, and neither is a recording.
+    spec_path = sweep_spec(tmp_path, "one", speeds(1))
+    out, folder = tmp_path / "one.jsonl", tmp_path / "one_rrd"
+    (folder / "one").mkdir(parents=True)
+    dead = dead_pid()
+    stale = [
+        folder / "one" / f".0009-dead.{dead}@{host_tag()}.tmp.rrd",
+        folder / f".0008-old.{dead}.tmp.rrd",  # named by older code, without the host
+    ]
+    args = ["sweep", str(spec_path), "--out", str(out), "--record", "all", "--workers", "1"]
+    with live_pid() as running:
+        live = folder / "one" / f".0007-live.{running}@{host_tag()}.tmp.rrd"
+        for path in (*stale, live):
+            path.write_bytes(b"partial")
+        assert main(args) == 0
+    assert capsys.readouterr().out.splitlines()[-1] == f"recordings (every run): 1 in {folder}"
+    assert not any(p.exists() for p in stale) and live.exists()
+
+
+def test_a_run_that_fails_mid_run_drops_its_partial_recording(tmp_path: Path) -> None:
+    # A worker reports a failed run and goes on: the recording it had started must go.
+    from sim.runs.runner import run
+
+    (spec,) = expand_spec(load_spec(sweep_spec(tmp_path, "fails", speeds(1))))
+    folder = tmp_path / "rrd"
+    spec = replace(spec, record="all", record_dir=str(folder))
+
+    def fail(frame: int) -> None:
+        if frame == 2:
+            assert temporaries(folder), "the recording has not started: nothing is tested"
+            raise RuntimeError("the run broke")
+
+    with pytest.raises(RuntimeError, match="the run broke"):
+        run(spec, on_frame=fail)
+    assert [p for p in folder.rglob("*") if p.is_file()] == []
 
 
 def stubborn_work(spec: RunSpec, kept: KeptRenderContext | None) -> dict[str, Any]:
@@ -446,19 +540,34 @@ def test_dataset_and_closed_loop_stop_within_seconds_with_their_line(
     assert dataset.last_line() == f"monopic dataset: {word}"
     assert "Traceback" not in dataset.text()
     assert gone_within(workers, STOP_BOUND_S), "a dataset worker lives on"
+    assert temporaries(folder) == []
 
     scenario = sweep_spec(tmp_path, "loop", speeds(1), duration=3.0).with_name("loop.toml")
+    rrd = tmp_path / "loop_rrd"
+    rrd.mkdir()
     loop = Command.start(
-        ["closed-loop", str(scenario), "--speeds", "1,2", "--policies", "none,truth"],
+        ["closed-loop", str(scenario), "--speeds", "1,2", "--policies", "none,truth",
+         "--rrd-dir", str(rrd)],
         tmp_path,
         "loop",
-    )
+    )  # fmt: skip
     commands.append(loop)
     loop.wait_for(lambda: "| 1/4 [" in loop.text(), "a finished run")
     seconds = loop.stop(sig)
     assert seconds < STOP_BOUND_S and loop.proc.returncode == code
     assert loop.last_line() == f"monopic closed-loop: {word}"
     assert "Traceback" not in loop.text()
+    assert temporaries(rrd) == []
+
+    out = tmp_path / "record" / "loop.rrd"
+    out.parent.mkdir()
+    record = Command.start(["record", str(scenario), "--rrd", str(out)], tmp_path, "record")
+    commands.append(record)
+    record.wait_for(lambda: bool(temporaries(out.parent)), "the recording started")
+    seconds = record.stop(sig)
+    assert seconds < STOP_BOUND_S and record.proc.returncode == code
+    assert record.last_line() == f"monopic record: {word}"
+    assert list(out.parent.iterdir()) == []  # neither the file nor its temporary
 
 
 # -- dead workers, killed sweeps -------------------------------------------------------------
