@@ -132,17 +132,16 @@ def triage_lines(m: SweepMetrics, rows: Sequence[RunResult], where: Rerunning) -
     lines = [
         "## Runs to look at",
         "",
-        f"The runs where the primary predictor, {first} (its warning is the robot's), missed a",
-        "collision (no warning before contact), warned late (less than "
+        f"The runs where the primary predictor, {first} (its warning is the robot's), missed",
+        "a collision (no warning before contact), warned late (less than "
         f"{LEAD_GOAL:g} s before contact:",
         f"counted by recall, not by recall@{LEAD_GOAL:g}s) or warned on a near miss; at most "
-        f"{PER_FAMILY} per family,",
-        "the worst first (missed, then late by lead, then near misses by frames warned), the "
-        "rest counted.",
-        "Each command runs the run again (from the folder the sweep ran in: a results line names",
-        "its scenario file as the sweep found it) into a rerun recording and checks that it gives",
-        "the same frames and decisions; `monopic view FILE.rrd` opens a recording, one lane per",
-        "predictor.",
+        f"{PER_FAMILY} per family, the",
+        "worst first (missed, then late by lead, then near misses by frames warned), the rest",
+        "counted. Each command runs its run again into a rerun recording and checks that it",
+        "gives the same frames and decisions (run it from the folder the sweep ran in: a",
+        "results line names its scenario file as the sweep found it); `monopic view FILE.rrd`",
+        "opens a recording, one lane per predictor.",
         "",
     ]
     if not wrong:

@@ -46,9 +46,10 @@ def register(sub: argparse._SubParsersAction) -> None:
 def run(args: argparse.Namespace) -> int:
     from monopic.cli.args import output_file
     from monopic.errors import UserError
+    from sim.analysis.triage import describe
     from sim.commands.report import check_results_file
     from sim.runs.code_version import code_version
-    from sim.runs.rebuild import code_of, find_line, first_difference, kind_of
+    from sim.runs.rebuild import Asked, code_of, find_line, first_difference, kind_of
 
     results: Path = args.results
     if not results.is_file():
@@ -71,10 +72,12 @@ def run(args: argparse.Namespace) -> int:
             "that made it, or add --anyway to run it with this code and see the first difference"
         )
     out = args.out or results.with_name(f"{results.stem}_rerun") / f"{args.run_id}.rrd"
-    spec = kind.rebuild(line, results, out, args.intent_tree)
+    asked = Asked(results, out, args.intent_tree, args.anyway)
+    spec = kind.rebuild(line, asked)
     output_file(out, "--out")
-    rerun = kind.rerun(line, spec, results)
-    print(f"run {args.run_id} ({line.get('family', '?')}, {describe(line.get('params'))}): "
+    rerun = kind.rerun(line, spec, asked)
+    params = line.get("params") if isinstance(line.get("params"), dict) else {}
+    print(f"run {args.run_id} ({line.get('family', '?')}, {describe(params)}): "
           f"{rerun.again.get('frames')} frames, contact "
           f"{_contact(rerun.again.get('contact_time'))}")  # fmt: skip
     print(f"recording: {rerun.recording}; open it with: monopic view {rerun.recording}")
@@ -84,13 +87,6 @@ def run(args: argparse.Namespace) -> int:
         return 0
     print(f"not the same as in the sweep: first difference at {difference}")
     return 1
-
-
-def describe(params: object) -> str:
-    """'robot.speed = 2, duration = 2' (the swept values), or 'the file's values'."""
-    if not isinstance(params, dict) or not params:
-        return "the file's values"
-    return ", ".join(f"{k} = {v}" for k, v in params.items())
 
 
 def _contact(time: object) -> str:

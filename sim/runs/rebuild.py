@@ -49,18 +49,30 @@ class Rerun:
 
 
 @dataclass(frozen=True)
+class Asked:
+    """What the user asked of a rerun: the results file, the recording to write, the
+    intent tree file (None: the shipped one the line names), and whether a line of other
+    code is run anyway."""
+
+    results: Path
+    out: Path
+    intent_tree: Path | None = None
+    anyway: bool = False
+
+
+@dataclass(frozen=True)
 class LineKind:
     """A kind of result line that can be run again.
 
-    `tells(line)`: whether a line is of this kind. `rebuild(line, results, out, intent_tree)`:
-    the run as a worker receives it, recording into `out` (UserError, one line, when the
-    line cannot be rebuilt: nothing is run or written then). `rerun(line, run, results)`:
-    that run done again, beside the stored line (`results`: the results file)."""
+    `tells(line)`: whether a line is of this kind. `rebuild(line, asked)`: the run as a
+    worker receives it, recording into `asked.out` (UserError, one line, when the line
+    cannot be rebuilt: nothing is run or written then). `rerun(line, run, asked)`: that
+    run done again, beside the stored line."""
 
     name: str
     tells: Callable[[dict[str, Any]], bool]
-    rebuild: Callable[[dict[str, Any], Path, Path, Path | None], Any]
-    rerun: Callable[[dict[str, Any], Any, Path], Rerun]
+    rebuild: Callable[[dict[str, Any], Asked], Any]
+    rerun: Callable[[dict[str, Any], Any, Asked], Rerun]
 
 
 def find_line(results: Path, run_id: str) -> dict[str, Any]:
@@ -128,7 +140,9 @@ def intent_tree_of(row: RunResult, results: Path, given: Path | None) -> Path | 
     )
 
 
-def scenario_file_of(row: RunResult, results: Path) -> tuple[ScenarioFile, Scenario]:
+def scenario_file_of(
+    row: RunResult, results: Path, anyway: bool = False
+) -> tuple[ScenarioFile, Scenario]:
     """The run's scenario file and its scenario at seed 0, rebuilt with the run's params.
 
     A line names its file as the sweep found it, relative to the folder the sweep ran in
@@ -136,7 +150,8 @@ def scenario_file_of(row: RunResult, results: Path) -> tuple[ScenarioFile, Scena
     for from here, from the results file's folder and from the checkout's top folder (where
     `make demo` runs its sweeps). The first that gives the run's digest (the last part of
     its id) is the run's: a file that does not is another file, or the file changed.
-    UserError (one line) when none does."""
+    UserError (one line) when none does, unless `anyway` (a line of other code, whose
+    scenarios may digest differently): then the first file found."""
     name = Path(row.file)
     bases = [Path()] if name.is_absolute() else [Path(), results.parent, CHECKOUT]
     found = list(dict.fromkeys(b / name for b in bases if (b / name).is_file()))
@@ -153,6 +168,9 @@ def scenario_file_of(row: RunResult, results: Path) -> tuple[ScenarioFile, Scena
         if row.id.endswith(f"-{digest}"):
             return scenario_file, probe
         digests.append(digest)
+    if anyway:
+        scenario_file = load(found[0])
+        return scenario_file, run_scenario(scenario_file, row.params)[1]
     raise UserError(
         f"{found[0]}: it no longer gives run {row.id} of {results} (with the run's params its "
         f"scenario's digest is {digests[0]}): the file changed since the sweep; restore it "
@@ -160,10 +178,10 @@ def scenario_file_of(row: RunResult, results: Path) -> tuple[ScenarioFile, Scena
     )
 
 
-def rebuild(row: RunResult, results: Path, out: Path, intent_tree: Path | None = None) -> RunSpec:
-    """The RunSpec of a sweep's line, recording into `out`; UserError (one line) when the
-    scenario file is missing or no longer gives the run (it changed since the sweep)."""
-    scenario_file, probe = scenario_file_of(row, results)
+def rebuild(row: RunResult, asked: Asked) -> RunSpec:
+    """The RunSpec of a sweep's line, recording into `asked.out`; UserError (one line) when
+    the scenario file is missing or no longer gives the run (it changed since the sweep)."""
+    scenario_file, probe = scenario_file_of(row, asked.results, asked.anyway)
     return RunSpec(
         id=row.id,
         scenario=replace(probe, name=row.id, seed=row.seed),
@@ -175,19 +193,17 @@ def rebuild(row: RunResult, results: Path, out: Path, intent_tree: Path | None =
         sweep=row.sweep,
         ablation=ABLATION in row.pipelines,
         record="all",
-        record_file=str(out),
-        intent_tree=str(intent_tree_of(row, results, intent_tree) or ""),
+        record_file=str(asked.out),
+        intent_tree=str(intent_tree_of(row, asked.results, asked.intent_tree) or ""),
         code=row.code or "",
     )
 
 
-def rebuild_sweep_line(
-    line: dict[str, Any], results: Path, out: Path, intent_tree: Path | None
-) -> RunSpec:
-    return rebuild(RunResult.from_json(line, str(results)), results, out, intent_tree)
+def rebuild_sweep_line(line: dict[str, Any], asked: Asked) -> RunSpec:
+    return rebuild(RunResult.from_json(line, str(asked.results)), asked)
 
 
-def rerun_sweep_line(line: dict[str, Any], spec: RunSpec, results: Path) -> Rerun:
+def rerun_sweep_line(line: dict[str, Any], spec: RunSpec, asked: Asked) -> Rerun:
     """A sweep's run done again on one worker of the sweep's own executor (so in the
     environment every sweep worker has), recording as `spec` says."""
     from sim.runs.executors import local_executor
@@ -197,10 +213,8 @@ def rerun_sweep_line(line: dict[str, Any], spec: RunSpec, results: Path) -> Reru
     (again,) = came
     if "error" in again:
         raise RuntimeError(f"run {spec.id} failed when run again:\n{again['error']}")
-    stored = RunResult.from_json(line, str(results))
-    return Rerun(
-        _comparable(stored), _comparable(RunResult.from_json(again)), Path(spec.record_file)
-    )
+    stored = RunResult.from_json(line, str(asked.results))
+    return Rerun(_comparable(stored), _comparable(RunResult.from_json(again)), asked.out)
 
 
 def _comparable(result: RunResult) -> dict[str, Any]:

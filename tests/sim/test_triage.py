@@ -160,13 +160,17 @@ def test_rerun_gives_the_sweeps_frames_and_decisions_and_a_readable_recording(
     assert counts["/camera/image"] == line["frames"]
     assert counts == rows_per_entity(tmp_path / "tiny_rrd" / line["recording"])
 
-    # A line that does not hold what the run gives is caught, at its first difference.
+    # A line that does not hold what the run gives is caught, at its first difference
+    # (here also a line of other code, which --anyway runs).
     warn = line["pipelines"]["main"]["decisions"]["rules/image"]["warn"]
     k = next(i for i, w in enumerate(warn) if w is not None)
     warn[k] = 1 - warn[k]
+    line["code"] = "0123456789ab"
     edited = tmp_path / "edited.jsonl"
     edited.write_text(json.dumps(line) + "\n")
-    assert main(["rerun", str(edited), line["id"]]) == 1
+    assert main(["rerun", str(edited), line["id"]]) == 2
+    assert "--anyway" in capsys.readouterr().err
+    assert main(["rerun", str(edited), line["id"], "--anyway"]) == 1
     printed = capsys.readouterr().out
     assert (
         f"first difference at pipelines.main.decisions.rules/image.warn[{k}] (frame {k}, "
