@@ -28,6 +28,7 @@ from sim.analysis.metrics import (
     paired_by_family,
     split_method,
 )
+from sim.analysis.triage import Rerunning, triage_lines
 from sim.runs.result import RunResult
 
 
@@ -319,6 +320,7 @@ def write_report(
         *goal_lines(m),
         "",
         *paired_lines(m),
+        *triage_lines(m, rows, Rerunning.of(results, out_dir)),
         "## By pedestrian behaviour and intent cues",
         "",
         "Walker model (`rail`: the Euro NCAP target; `human`: sim/scenario/human.py) and",

@@ -38,6 +38,7 @@ def run(args: argparse.Namespace) -> int:
     from monopic.errors import UserError
     from sim.analysis.metrics import compute
     from sim.analysis.report import ran_on, sweeps_line, write_report
+    from sim.analysis.triage import triage_summary
     from sim.runs.results_file import read_results
 
     results: Path = args.results
@@ -62,12 +63,16 @@ def run(args: argparse.Namespace) -> int:
     print(report.headline)
     print(f"\n{ran_on(metrics)}")
     print(sweeps_line(rows).replace("`", ""))
+    triage = triage_summary(metrics)
+    if triage:
+        print(triage)
     print(f"report: {report.markdown} ({len(report.plots)} plots)")
     return 0
 
 
 def check_results_file(path: Path) -> None:
-    """UserError unless the file's first line is a sweep's result line (JSON with an id).
+    """UserError unless the file's first line (blank ones skipped) is a sweep's result
+    line (JSON with an id).
 
     A CSV or any other file given by mistake is named as such here, rather than by the
     results reader's advice for a bad line in a sweep's own file."""
@@ -75,9 +80,9 @@ def check_results_file(path: Path) -> None:
 
     from monopic.errors import UserError
 
-    with path.open("rb") as fh:
-        first = fh.readline()
-    if not first.strip():
+    with path.open("rb") as fh:  # a results file has no blank line: any other file may
+        first = next((line for line in fh if line.strip()), b"")
+    if not first:
         return  # empty: the caller says there are no runs yet
     try:
         row = json.loads(first)

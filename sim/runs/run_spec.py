@@ -30,5 +30,7 @@ class RunSpec:
     # or raised a false alarm, "all" keeps every run, "none" records nothing.
     record: str = "none"
     record_dir: str = ""
+    # The .rrd file itself, instead of record_dir/<id>.rrd (`monopic rerun --out`).
+    record_file: str = ""
     intent_tree: str = ""  # a ground intent tree file: also run predictor intent-tree/ground
     code: str = ""  # sim.runs.code_version of the code that runs it, written into the result

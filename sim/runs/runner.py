@@ -178,11 +178,13 @@ def _start_recording(spec: RunSpec, world: World):
         raise ValueError(f"record must be none, failed or all, got {spec.record!r}")
     from sim.recording.sim_recording import SimRecording
 
-    path = Path(spec.record_dir or "recordings") / recording_name(spec)
+    folder = Path(spec.record_dir or "recordings")
+    path = Path(spec.record_file) if spec.record_file else folder / recording_name(spec)
     path.parent.mkdir(parents=True, exist_ok=True)
     return SimRecording(path, world)
 
 
 def recording_name(spec: RunSpec) -> str:
-    """The run's recording, relative to the sweep's recordings folder (ids nest by family)."""
-    return f"{spec.id}.rrd"
+    """The run's recording, relative to the sweep's recordings folder (ids nest by family),
+    or the file a rerun was asked to write."""
+    return spec.record_file or f"{spec.id}.rrd"

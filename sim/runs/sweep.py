@@ -48,6 +48,7 @@ from sim.scenario.files import (
     load,
     parse_parameters,
 )
+from sim.scenario.spec import Scenario
 from sim.scenario.toml_table import TomlTable, read_toml
 
 INCLUDE_SAMPLING = ("file", "base", "grid", "random")
@@ -182,6 +183,19 @@ def run_id(file: ScenarioFile, index: int, digest: str) -> str:
     return f"{file.name}/{index:04d}-{digest}"
 
 
+def run_scenario(file: ScenarioFile, params: Mapping[str, Any]) -> tuple[Scenario, Scenario, str]:
+    """A run's scenario as built from the file and its params, the same at seed 0, and the
+    digest of that (the last part of its run id): what `monopic rerun` rebuilds a run with."""
+    built = file.scenario(params, name=file.name)
+    probe = replace(built, seed=0)
+    return built, probe, hashlib.sha1(repr(probe).encode()).hexdigest()[:8]
+
+
+def run_seed(file: ScenarioFile, digest: str, seed: int) -> int:
+    """The run's world seed: the file's (or a swept) seed mixed with the scenario's digest."""
+    return (seed + zlib.crc32(f"{file.name}:{digest}".encode())) % 2**31
+
+
 def expand_spec(spec: SweepSpec) -> list[RunSpec]:
     """Every run of the sweep, validated, in a stable order (duplicates dropped)."""
     runs: list[RunSpec] = []
@@ -196,9 +210,7 @@ def expand_spec(spec: SweepSpec) -> list[RunSpec]:
                 raise ScenarioFileError(path, "sweep", include.sampling, str(err)) from None
             drawn: set[tuple[str, int]] = set()
             for index, params in enumerate(combos):
-                built = file.scenario(params, name=file.name)
-                probe = replace(built, seed=0)
-                digest = hashlib.sha1(repr(probe).encode()).hexdigest()[:8]
+                built, probe, digest = run_scenario(file, params)
                 rid = run_id(file, index, digest)
                 # The same scenario twice (e.g. a walking speed swept for a person who
                 # stands) is one run: its results would be identical. A swept `seed` makes
@@ -207,7 +219,7 @@ def expand_spec(spec: SweepSpec) -> list[RunSpec]:
                     continue
                 seen.add(rid)
                 drawn.add((digest, built.seed))
-                seed = (built.seed + zlib.crc32(f"{file.name}:{digest}".encode())) % 2**31
+                seed = run_seed(file, digest, built.seed)
                 runs.append(
                     RunSpec(
                         id=rid,
@@ -271,8 +283,15 @@ def sweep_code(spec: SweepSpec) -> str:
     code = code_version()
     if spec.intent_tree is None:
         return code
-    digest = hashlib.sha256(spec.intent_tree.read_bytes()).hexdigest()[:8]
-    return f"{code}+tree-{digest}"
+    return f"{code}{TREE_TAG}{tree_digest(spec.intent_tree)}"
+
+
+TREE_TAG = "+tree-"  # joins the code version and the intent tree's digest (sweep_code)
+
+
+def tree_digest(path: Path) -> str:
+    """8 hex digits over an intent tree file's bytes."""
+    return hashlib.sha256(path.read_bytes()).hexdigest()[:8]
 
 
 def run_sweep(
