@@ -309,8 +309,9 @@ def load(path: Path | str) -> ScenarioFile:
 def _check_parameters(path: Path, data: dict[str, Any], sweep: Sweep) -> None:
     """Every value of every parameter must build on its own (type, range, known key)."""
     for key, dist in sweep.parameters.items():
-        if key.split(".")[0] in ("sweep", "name", "family", "kind", "scale"):
-            raise ScenarioFileError(path, f"sweep.parameters.{key}", MISSING, "cannot be swept")
+        reason = unsweepable(key)
+        if reason is not None:
+            raise ScenarioFileError(path, f"sweep.parameters.{key}", MISSING, reason)
         values = dist.grid() if isinstance(dist, Values) or dist.steps else (dist.low, dist.high)
         for value in values:
             try:
@@ -323,6 +324,27 @@ def _check_parameters(path: Path, data: dict[str, Any], sweep: Sweep) -> None:
                 # Other failures depend on the combination; the sweep checks each run.
             except ValueError as err:
                 raise ScenarioFileError(path, f"sweep.parameters.{key}", value, str(err)) from None
+
+
+# Keys that label a file's runs rather than describe its scenario: the runs keep the
+# file's own (its results, its report row, its run ids), so a sweep cannot vary them.
+LABEL_KEYS = ("name", "family", "kind", "description", "sweep")
+
+
+def unsweepable(key: str) -> str | None:
+    """Why a dotted key cannot be swept; None when every run applies it to its scenario.
+
+    The one rule for a scenario file's [sweep.parameters] and a sweep spec's
+    [include.parameters]."""
+    top = key.split(".")[0]
+    if top not in LABEL_KEYS:
+        return None
+    if top == "sweep":
+        return "cannot be swept: [sweep] says how the file is swept, it is not a scenario value"
+    return (
+        f"cannot be swept: the file's {top} labels all its runs (their results and the "
+        f"report keep it); to vary it, write one scenario file per {top}"
+    )
 
 
 # -- values given on the command line -------------------------------------------------

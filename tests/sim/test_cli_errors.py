@@ -171,8 +171,11 @@ def test_dry_run_shows_runs_per_family_and_a_time_it_says_how_it_computed(
     )
     assert not out.exists()  # a dry run writes nothing
     # Finished runs in the results file replace the benchmark's figure by their own.
-    rows = [{"id": "x/1", "frames": 10, "timing": {"wall_s": 3.0}},
-            {"id": "x/2", "frames": 30, "timing": {"wall_s": 5.0}}]  # fmt: skip
+    from sim.runs.sweep import load_spec, sweep_code
+
+    mine = {"sweep": "t", "code": sweep_code(load_spec(spec))}  # else the run would refuse it
+    rows = [{"id": "x/1", "frames": 10, "timing": {"wall_s": 3.0}, **mine},
+            {"id": "x/2", "frames": 30, "timing": {"wall_s": 5.0}, **mine}]  # fmt: skip
     out.write_text("".join(json.dumps(r) + "\n" for r in rows))
     assert main(["sweep", str(spec), "--out", str(out), "--dry-run", "--no-ablation"]) == 0
     time_line = capsys.readouterr().out.splitlines()[4]
