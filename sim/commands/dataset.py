@@ -9,7 +9,6 @@ from pathlib import Path
 from tqdm import tqdm
 
 from monopic.cli.args import output_folder
-from monopic.errors import UserError
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -47,11 +46,12 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim.dataset.build import build, estimate, estimate_duration, finished_runs
+    from sim.dataset.build import build, check_folder, estimate, estimate_duration, finished_runs
     from sim.dataset.spec import expand, load_spec
 
     spec = load_spec(args.spec)
     out: Path = args.out
+    check_folder(spec, out)  # the estimate refuses what the build would
     if args.estimate_only:
         runs = expand(spec)
         done = finished_runs(out, runs) if out.is_dir() else {}
@@ -59,8 +59,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"size: {estimate(runs, list(done.values())).text()}")
         print(f"time: {estimate_duration(todo, list(done.values())).text()}")
         return 0
-    if out.exists() and not out.is_dir():
-        raise UserError(f"--out {out}: is a file, not a dataset folder")
     output_folder(out.parent, "--out")
     bars: list[tqdm] = []
 

@@ -487,3 +487,39 @@ def test_output_piped_into_a_reader_that_stops_early_ends_quietly() -> None:
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 141, proc.stderr
     assert "Traceback" not in proc.stderr and "BrokenPipeError" not in proc.stderr
+
+
+def test_a_dataset_estimate_refuses_what_the_build_refuses_with_the_same_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import json
+
+    import sim.dataset.build
+
+    def no_render(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a run was rendered before the folder was checked")
+
+    monkeypatch.setattr(sim.dataset.build, "render_run", no_render)
+    (tmp_path / "tiny.toml").write_text(TINY.split("[sweep]")[0])
+    spec = tmp_path / "spec.toml"
+    spec.write_text('name = "t"\n[[include]]\nfiles = ["tiny.toml"]\nsampling = "base"\n')
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "notes.txt").write_text("x")
+    another = tmp_path / "another"
+    another.mkdir()
+    (another / "dataset.json").write_text(json.dumps({"name": "o", "spec_digest": "0"}))
+    for out, expected in [
+        (a_file, f"--out {a_file}: is a file, not a dataset folder"),
+        (a_file / "ds", f"--out {a_file}: a file is in the way of this folder"),
+        (other, f"{other}: exists and is not empty (and is not a dataset of this spec)"),
+        (another, f"{another}: holds dataset 'o' made from another spec (digest 0 vs "),
+    ]:
+        lines = []
+        for estimate in (["--estimate-only"], []):
+            assert main(["dataset", str(spec), "--out", str(out), *estimate]) == 2
+            lines.append(one_line_error(capsys))
+        assert lines[0] == lines[1]
+        assert lines[0].startswith(f"monopic dataset: error: {expected}"), lines[0]
