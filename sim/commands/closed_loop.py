@@ -21,6 +21,7 @@ FAMILY_FOLDER = Path("scenarios/families/small")
 NCAP_FAMILIES = ("cpna25", "cpna75", "cpfa50", "cpnco50", "cpla25", "cpla50")
 DEFAULT_POLICIES = "none,truth,rules/image,rules/ground"
 MEET_TIME = 3.0  # s: --cases crossings meet the robot then unless it brakes
+CASE_SPEEDS = "1,2,3"  # m/s: --cases has no file to take a speed from
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -33,14 +34,17 @@ def register(sub: argparse._SubParsersAction) -> None:
         "predictor warns; the command acts after the pipeline's measured latency, at the "
         "next frame boundary). Prints contact rate, impact speed and minimum footprint gap "
         "per policy. Default scenarios: the small-robot Euro NCAP-style collision families "
-        f"({', '.join(NCAP_FAMILIES)} in {FAMILY_FOLDER}) at each --speeds.",
+        f"({', '.join(NCAP_FAMILIES)} in {FAMILY_FOLDER}). A scenario file (a default family "
+        "too) runs at its own robot speed and seed unless --speeds or --seed replace them, "
+        "with the file's checks (e.g. its robot's max_speed).",
     )
     p.add_argument(
         "files",
         nargs="*",
         type=Path,
         metavar="SCENARIO.toml",
-        help="scenario files, each run at every --speeds (default: the families above)",
+        help="scenario files, each at its own robot speed or at every --speeds (default: "
+        "the families above)",
     )
     p.add_argument(
         "--cases",
@@ -48,7 +52,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         f"(they meet the robot's front at {MEET_TIME:g} s unless it brakes)",
     )
     p.add_argument(
-        "--speeds", default="1,2,3", help="robot speeds, m/s, comma-separated (default %(default)s)"
+        "--speeds",
+        help="robot speeds, m/s, comma-separated (default: each file's own robot.speed; "
+        f"--cases: {CASE_SPEEDS})",
     )
     p.add_argument(
         "--policies",
@@ -63,7 +69,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="apply this fixed latency instead of the measured one",
     )
     p.add_argument(
-        "--seed", type=int, default=0, help="environment seed: the gait phase (default %(default)d)"
+        "--seed",
+        type=int,
+        help="environment seed: the gait phase (default: each file's own seed; --cases: 0)",
     )
     p.add_argument("--out", type=Path, help="write the tables (Markdown) here")
     p.add_argument("--rrd-dir", type=Path, help="record every braking run into this folder")
@@ -80,11 +88,11 @@ def _numbers(text: str, option: str) -> list[float]:
     return values
 
 
-def case_scenarios(cases: str, speeds: list[float]) -> list[Scenario]:
+def case_scenarios(cases: str, speeds: list[float], seed: int | None = None) -> list[Scenario]:
+    """Crossings on a collision course, each placed as a small-scale scenario file with
+    path.kind = "case" would place it (sim.scenario.files.placed_case): its checks."""
     from monopic.cases import Case
-    from sim.scenario.cases import CasePlacement
-    from sim.scenario.families import PlacementError
-    from sim.scenario.files import street_problem
+    from sim.scenario.files import Given, placed_case
 
     out = []
     for text in cases.split(","):
@@ -97,35 +105,42 @@ def case_scenarios(cases: str, speeds: list[float]) -> list[Scenario]:
         for v in speeds:
             if v <= 0:
                 raise UserError("--speeds: a crossing needs a moving robot (> 0 m/s)")
-            try:
-                placement = CasePlacement(
-                    case,
-                    distance=v * MEET_TIME,
-                    robot_speed=v,
-                    meet_time=MEET_TIME,
-                    duration=MEET_TIME + 1.0,
-                )
-            except PlacementError as err:  # e.g. a robot speed beyond the placement's range
-                message = f"--speeds {v:g}: case {int(case)}: {err.field} {err.reason}"
-                raise UserError(message) from None
-            scenario = placement.scenario(name=f"case{int(case)}@{v:g}")
-            problem = street_problem(scenario)  # as a scenario file with these values
-            if problem is not None:
-                message = f"--speeds {v:g}: case {int(case)}: {problem.field} {problem.reason}"
-                raise UserError(message)
-            out.append(scenario)
+            given = [Given("--speeds", "robot.speed", v)]
+            if seed is not None:
+                given.append(Given("--seed", "seed", seed))
+            fixed = {"path.distance": v * MEET_TIME, "path.meet_time": MEET_TIME,
+                     "duration": MEET_TIME + 1.0}  # fmt: skip
+            name = f"case{int(case)}@{v:g}"
+            out.append(placed_case(case, given, fixed, name=name, where=f"case {int(case)}: "))
     return out
 
 
-def file_scenarios(files: list[Path], speeds: list[float], seed: int) -> list[Scenario]:
-    from sim.scenario.files import load
+def file_scenarios(
+    files: list[Path], speeds: list[float] | None, seed: int | None
+) -> list[Scenario]:
+    """Each file at its own robot speed and seed, or at each of `speeds` and at `seed`:
+    given values go through the file's checks (ScenarioFile.with_given)."""
+    from sim.scenario.files import Given, load
 
     out = []
     for path in files:
         sf = load(path)
-        for v in speeds:
-            out.append(sf.scenario({"robot.speed": v}, name=f"{sf.name}@{v:g}", seed=seed))
+        seeds = [] if seed is None else [Given("--seed", "seed", seed)]
+        for v in speeds if speeds is not None else [sf.base.robot.speed]:
+            given = [Given("--speeds", "robot.speed", v)] if speeds is not None else []
+            out.append(sf.with_given(given + seeds, name=f"{sf.name}@{v:g}"))
     return out
+
+
+def _speeds_seen(scenarios: list[Scenario]) -> str:
+    """The robot speeds the scenarios start at, as the footer names them."""
+    speeds = sorted({s.robot.speed for s in scenarios})
+    return ",".join(f"{v:g}" for v in speeds)
+
+
+def _seeds_seen(scenarios: list[Scenario]) -> str:
+    """The scenarios' seeds, as the footer names them."""
+    return ",".join(str(v) for v in sorted({s.seed for s in scenarios}))
 
 
 def run(args: argparse.Namespace) -> int:
@@ -138,7 +153,7 @@ def run(args: argparse.Namespace) -> int:
         summarise,
     )
 
-    speeds = _numbers(args.speeds, "--speeds")
+    speeds = None if args.speeds is None else _numbers(args.speeds, "--speeds")
     policies = [p.strip() for p in args.policies.split(",") if p.strip()]
     if not policies:
         raise UserError(f"--policies: no policy in {args.policies!r}")
@@ -152,12 +167,15 @@ def run(args: argparse.Namespace) -> int:
     if args.cases:
         if args.files:
             raise UserError("give scenario files or --cases, not both")
-        scenarios = case_scenarios(args.cases, speeds)
+        case_speeds = speeds if speeds is not None else _numbers(CASE_SPEEDS, "--speeds")
+        scenarios = case_scenarios(args.cases, case_speeds, args.seed)
         source = f"place_case crossings {args.cases} meeting the robot at {MEET_TIME:g} s"
+        chosen = "--speeds" if speeds is not None else "the --cases default"
     else:
         files = args.files or [FAMILY_FOLDER / f"{name}.toml" for name in NCAP_FAMILIES]
         scenarios = file_scenarios(files, speeds, args.seed)
         source = ", ".join(str(f) for f in files)
+        chosen = "--speeds" if speeds is not None else "each file's own"
     if args.out is not None:
         output_file(args.out, "--out")
     if args.rrd_dir is not None:
@@ -173,7 +191,11 @@ def run(args: argparse.Namespace) -> int:
                 try:
                     outcomes.append(
                         run_closed_loop(
-                            scenario, policy, seed=args.seed, latency_ms=args.latency_ms, rrd=rrd
+                            scenario,
+                            policy,
+                            seed=scenario.seed,
+                            latency_ms=args.latency_ms,
+                            rrd=rrd,
                         )
                     )
                 except ValueError as err:
@@ -181,9 +203,14 @@ def run(args: argparse.Namespace) -> int:
                 bar.update(1)
     cam = scenarios[0].robot.camera
     latency = "measured per frame" if args.latency_ms is None else f"fixed {args.latency_ms:g} ms"
+    if args.seed is not None:
+        seeds = "--seed"
+    else:
+        seeds = "the --cases default" if args.cases else "each file's own"
     ran_on = (
-        f"{len(scenarios)} scenarios ({source}; robot speeds {args.speeds} m/s), seed "
-        f"{args.seed}, {cam.width}x{cam.height} frames at {1 / scenarios[0].dt:.0f} fps, "
+        f"{len(scenarios)} scenarios ({source}; robot speeds {_speeds_seen(scenarios)} m/s: "
+        f"{chosen}), seed {_seeds_seen(scenarios)} ({seeds}), {cam.width}x{cam.height} frames "
+        f"at {1 / scenarios[0].dt:.0f} fps, "
         f"horizon {scenarios[0].horizon:g} s, latency {latency}; "
         f"{platform.processor() or platform.machine()}, {platform.node()}"
     )

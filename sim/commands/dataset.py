@@ -59,7 +59,14 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from sim.commands.sweep import logs_above_the_bar
-    from sim.dataset.build import build, estimate, estimate_duration, finished_runs, work
+    from sim.dataset.build import (
+        build,
+        check_folder,
+        estimate,
+        estimate_duration,
+        finished_runs,
+        work,
+    )
     from sim.dataset.spec import expand, load_spec
     from sim.runs.executors import local_executor, ray_executor
 
@@ -71,6 +78,7 @@ def run(args: argparse.Namespace) -> int:
     out: Path = args.out
     # None: a Ray cluster's CPUs, unknown here (the estimate then gives CPU time).
     workers = None if args.executor == "ray" else (args.workers or os.cpu_count() or 1)
+    check_folder(spec, out)  # the estimate refuses what the build would
     if args.estimate_only:
         runs = expand(spec)
         done = finished_runs(out, runs) if out.is_dir() else {}
@@ -78,8 +86,6 @@ def run(args: argparse.Namespace) -> int:
         print(f"size: {estimate(runs, list(done.values())).text()}")
         print(f"time: {estimate_duration(todo, list(done.values()), workers).text()}")
         return 0
-    if out.exists() and not out.is_dir():
-        raise UserError(f"--out {out}: is a file, not a dataset folder")
     output_folder(out.parent, "--out")
     if args.executor == "ray":
         executor = ray_executor(args.address, run=work)

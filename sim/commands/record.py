@@ -13,6 +13,7 @@ from monopic.cli.args import output_file
 from monopic.errors import UserError
 
 if TYPE_CHECKING:  # the simulator is imported when a command runs, not when the CLI starts
+    from sim.scenario.files import Given
     from sim.scenario.spec import Scenario
 
 DEFAULT_FOLDER = Path("recordings")
@@ -20,7 +21,10 @@ SCENARIO_HELP = """\
 SCENARIO is a case number 1-9 or its name (e.g. 5, case5, perpendicular-right), or
 `crossing` (an adult crossing into the robot's path; contact at 2.7 s unless it
 brakes), or a scenario file (scenarios/**/*.toml: its base scenario, without its sweep).
-Cases are placed by sim.scenario.cases.CasePlacement; the options below set its parameters.
+A case is placed by sim.scenario.cases.CasePlacement as a small-scale scenario file with
+path.kind = "case" would place it, with that file's checks; the options below set its
+values, and for a scenario file they replace the file's own (distance and lateral offset
+only where its path.kind is "case").
 """
 
 
@@ -52,22 +56,77 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.set_defaults(func=run)
 
 
-# CasePlacement's parameters the command offers (defaults and ranges are the placement's).
-CASE_OPTIONS = ("distance", "lateral_offset", "pedestrian_speed", "robot_speed", "duration", "seed")
+# The options that set a case's values (or a scenario file's), and the file keys they set.
+CASE_OPTIONS = {"distance": "path.distance", "lateral_offset": "path.lateral_offset",
+                "pedestrian_speed": "pedestrian.speed", "robot_speed": "robot.speed",
+                "duration": "duration", "seed": "seed"}  # fmt: skip
+
+
+def option_range(name: str) -> tuple[float, float, bool]:
+    """(low, high, low excluded) of a case option: the values it can take on the command
+    line, where a case is a small-scale file's (max_speed 3 m/s) on PLACED_SCENE's street.
+
+    Each is the placement's range narrowed by the file's checks: a standing pedestrian must
+    stand on the street (distance, lateral offset), the robot under its max_speed."""
+    from sim.scenario.cases import PLACEMENT_FIELDS
+    from sim.scenario.families import SMALL, street_bounds
+    from sim.scenario.files import PLACED_SCENE
+
+    meta = PLACEMENT_FIELDS[name].metadata
+    low, high = meta["low"], meta["high"]
+    x0, x1, y0, y1 = street_bounds(PLACED_SCENE.road)
+    if name == "distance":
+        low, high = max(low, x0), min(high, x1)
+    elif name == "lateral_offset":
+        low, high = max(low, y0), min(high, y1)
+    elif name == "robot_speed":
+        high = min(high, SMALL.robot.max_speed)
+    return low, high, bool(meta.get("open_low"))
+
+
+OPTION_NOTES = {
+    "distance": "to the street's end, where a standing pedestrian still stands on it; a "
+    "walking one's whole path must stay on the street",
+    "lateral_offset": "the street's width, as for --distance",
+    "pedestrian_speed": "a scenario file's pedestrian.speed may also be 0, on other paths: "
+    "a case walks at least at the ground mode's walking speed",
+    "robot_speed": "under the small robot's max_speed",
+}
+
+
+def option_help(name: str) -> str:
+    """A case option's meaning, range (option_range) and default, for --help."""
+    from sim.scenario.cases import PLACEMENT_FIELDS
+
+    meta, default = PLACEMENT_FIELDS[name].metadata, PLACEMENT_FIELDS[name].default
+    low, high, open_low = option_range(name)
+
+    def shown(v: float) -> str:
+        return str(v) if isinstance(v, int) else f"{v:g}"
+
+    unit = f" {meta['unit']}" if meta["unit"] else ""
+    note = f" ({OPTION_NOTES[name]})" if name in OPTION_NOTES else ""
+    span = f"{'(' if open_low else '['}{shown(low)}, {shown(high)}]{unit}"
+    return f"{meta['doc']}: {span}{note}; default {shown(default)}"
 
 
 def add_case_options(p: argparse.ArgumentParser) -> None:
-    """CasePlacement's parameters, for scenarios given as a case."""
-    from sim.scenario.cases import PLACEMENT_FIELDS, placement_help
+    """The case values (see SCENARIO_HELP); None when not given, so a file keeps its own."""
+    from sim.scenario.cases import PLACEMENT_FIELDS
 
-    g = p.add_argument_group("case placement (SCENARIO given as a case)")
+    g = p.add_argument_group(
+        "scenario values (default: the case placement's, or a scenario file's own)",
+        "A case is checked as a small-scale scenario file with these values: each in the "
+        "range below, and together the robot on its road for the whole run and the "
+        "pedestrian on the street. For a scenario file the file's own checks apply (its "
+        "robot's max_speed, its road).",
+    )
     for name in CASE_OPTIONS:
         f = PLACEMENT_FIELDS[name]
         g.add_argument(
             f"--{name.replace('_', '-')}",
             type=int if f.type in (int, "int") else float,
-            default=f.default,
-            help=placement_help(name),
+            help=option_help(name),
         )
 
 
@@ -86,16 +145,31 @@ def parse_case(text: str) -> Case | None:
     return None
 
 
-def resolve_scenario(text: str, args: argparse.Namespace) -> Scenario:
-    """The Scenario named on the command line (see SCENARIO_HELP)."""
-    from sim.scenario.cases import CasePlacement, default_crossing
-    from sim.scenario.families import PlacementError
-    from sim.scenario.files import load, street_problem
-    from sim.scenario.toml_table import show
+def given_values(args: argparse.Namespace) -> list[Given]:
+    """The case options given on the command line, as values of a scenario file's keys."""
+    from sim.scenario.files import Given
 
+    return [
+        Given(f"--{name.replace('_', '-')}", key, getattr(args, name))
+        for name, key in CASE_OPTIONS.items()
+        if getattr(args, name, None) is not None
+    ]
+
+
+def resolve_scenario(text: str, args: argparse.Namespace) -> Scenario:
+    """The Scenario named on the command line (see SCENARIO_HELP), with the values given."""
+    from sim.scenario.cases import default_crossing
+    from sim.scenario.files import load, placed_case
+
+    given = given_values(args)
     if text.endswith(".toml") or Path(text).is_file():
-        return load(Path(text)).base
+        return load(Path(text)).with_given(given)
     if text.strip().lower() == "crossing":
+        if given:
+            raise UserError(
+                f"{given[0].text}: 'crossing' is a fixed scenario; to set its values, place "
+                "case 5 (e.g. record 5 --distance 6 --duration 5)"
+            )
         return default_crossing()
     case = parse_case(text)
     if case is None:
@@ -103,21 +177,7 @@ def resolve_scenario(text: str, args: argparse.Namespace) -> Scenario:
             f"scenario {text!r}: not a case number 1-9, a case name (e.g. perpendicular-right), "
             "'crossing' or an existing .toml file"
         )
-    try:
-        placement = CasePlacement(case, **{name: getattr(args, name) for name in CASE_OPTIONS})
-    except PlacementError as err:
-        flag = f"--{err.field.replace('_', '-')}"
-        raise UserError(f"{flag} {err.value:g}: {err.reason}") from None
-    scenario = placement.scenario()
-    problem = street_problem(scenario)  # what a scenario file with these values is told
-    if problem is not None:
-        if problem.field == "robot.speed":
-            raise UserError(f"--robot-speed {problem.value:g}: {problem.reason}")
-        raise UserError(
-            f"--distance {args.distance:g} --lateral-offset {args.lateral_offset:g}: "
-            f"{problem.reason}; at {show(problem.value)}"
-        )
-    return scenario
+    return placed_case(case, given)
 
 
 def run(args: argparse.Namespace) -> int:

@@ -10,7 +10,7 @@ from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from monopic.cli.args import output_file, positive_int
+from monopic.cli.args import positive_int
 from monopic.output import is_temporary
 
 if TYPE_CHECKING:  # the simulator is imported when the command runs
@@ -88,7 +88,6 @@ def run(args: argparse.Namespace) -> int:
     if args.dry_run:
         dry_run(spec, out, args)
         return 0
-    output_file(out, "--out")
     if args.executor == "ray":
         executor = ray_executor(args.address)
     else:
@@ -170,15 +169,20 @@ def kept_recordings(folder: Path, record: str) -> str:
 
 
 def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
-    """Runs per family, what the results file already holds and the estimated time."""
+    """Runs per family, what the results file already holds and the estimated time.
+
+    It makes the run's checks (the spec's runs, then sim.runs.sweep.check_output): what
+    the run would refuse, it refuses with the same line."""
     from sim.runs.estimate import SWEEP_START_S, bench_frame_seconds, estimate_time
-    from sim.runs.result import SCHEMA
-    from sim.runs.results_file import read_rows, scan
-    from sim.runs.sweep import expand_spec, sweep_code
+    from sim.runs.results_file import read_rows
+    from sim.runs.sweep import check_output, expand_spec
 
     runs = expand_spec(spec)
-    state = scan(out) if out.exists() else None
-    done = state.ids if state else frozenset()
+    check = check_output(spec, out, args.record, args.recordings, args.restart)
+    for source, target in check.moves:
+        print(f"would set aside (--restart): {source} -> {target}")
+    state = check.state
+    done = check.done
     todo = [r for r in runs if r.id not in done]
     already = len(runs) - len(todo)
     limit = f" (--limit {args.limit})" if args.limit is not None else ""
@@ -193,13 +197,16 @@ def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
     if spec.intent_tree is not None:
         print(f"  also predictor intent-tree/ground with {spec.intent_tree}")
     width = max(len("family"), *(len(f) for f in families))
-    print(f"  {'family':<{width}}  {'kind':<9}  {'scale':<5}  runs  to run  frames (at most)")
+    scales = {f: "/".join(sorted({r.scale for r in m})) for f, m in families.items()}
+    scale_width = max(len("scale"), *(len(v) for v in scales.values()))
+    print(f"  {'family':<{width}}  {'kind':<9}  {'scale':<{scale_width}}  runs  to run  "
+          "frames (at most)")  # fmt: skip
     for family, members in sorted(families.items()):
         first = members[0]
         left = [r for r in members if r.id in todo_ids]
         frames = sum(r.scenario.frames for r in left)
-        print(f"  {family:<{width}}  {first.kind:<9}  {first.scale:<5}  {len(members):>4}  "
-              f"{len(left):>6}  {frames:>6}")  # fmt: skip
+        print(f"  {family:<{width}}  {first.kind:<9}  {scales[family]:<{scale_width}}  "
+              f"{len(members):>4}  {len(left):>6}  {frames:>6}")  # fmt: skip
     measured = []
     if state is not None:
         for row in read_rows(out):
@@ -221,11 +228,3 @@ def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
         SWEEP_START_S,
     )  # fmt: skip
     print(f"time: {time.text()}")
-    other = state.other_code(sweep_code(spec)) if state else None
-    if other:
-        print(f"{out}: {sum(other.values())} of its runs were made by other code "
-              "(a sweep would stop; --restart sets them aside)")  # fmt: skip
-    newer = state.newer_schema(SCHEMA) if state else None
-    if newer:
-        print(f"{out}:{newer[0]}: results of schema {newer[1]}, newer than this code's "
-              f"{SCHEMA} (a sweep would stop; --restart sets them aside)")  # fmt: skip

@@ -351,8 +351,18 @@ def finished_runs(out: Path, runs: list[DatasetRun]) -> dict[str, dict[str, Any]
     return done
 
 
-def prepare_folder(spec: DatasetSpec, out: Path) -> None:
-    """Create the folder, or check that it holds the same spec's dataset (resume)."""
+def check_folder(spec: DatasetSpec, out: Path) -> bool:
+    """Every check of the dataset folder before anything is rendered: a folder (or none
+    yet, with nothing in the way), empty or holding this spec's dataset. True when it holds
+    one (a resume). `--estimate-only` makes the same checks, so it refuses what a build
+    would refuse, with the same line."""
+    if out.exists() and not out.is_dir():
+        raise UserError(f"--out {out}: is a file, not a dataset folder")
+    for part in out.parents:
+        if part.exists():
+            if not part.is_dir():
+                raise UserError(f"--out {part}: a file is in the way of this folder")
+            break
     marker = out / "dataset.json"
     if marker.exists():
         try:
@@ -364,9 +374,16 @@ def prepare_folder(spec: DatasetSpec, out: Path) -> None:
                 f"{out}: holds dataset {made.get('name')!r} made from another spec "
                 f"(digest {made.get('spec_digest')} vs {spec.digest}); choose another --out"
             )
-        return
+        return True
     if out.exists() and any(out.iterdir()):
         raise UserError(f"{out}: exists and is not empty (and is not a dataset of this spec)")
+    return False
+
+
+def prepare_folder(spec: DatasetSpec, out: Path) -> None:
+    """Create the folder, or check that it holds the same spec's dataset (resume)."""
+    if check_folder(spec, out):
+        return
     for sub in ("images", "masks", "truth", "features", "runs", "annotations"):
         (out / sub).mkdir(parents=True, exist_ok=True)
     write_text_atomically(out / "spec.toml", spec.text)

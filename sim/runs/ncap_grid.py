@@ -24,7 +24,7 @@ from typing import Any
 from monopic.errors import UserError
 from sim.runs.aeb import AebParams, run_aeb
 from sim.runs.code_version import code_version
-from sim.runs.results_file import ResultsWriter, read_rows, scan
+from sim.runs.results_file import ResultsWriter, check_unlocked, read_rows, scan
 from sim.runs.runner import machine
 from sim.runs.sweep import run_missing, say_skipped
 from sim.scenario.files import load
@@ -161,19 +161,28 @@ class GridOutcome:
 
 
 def check_results(out: Path, restart: bool) -> None:
-    """Refuse (one line) a results file of other code unless `restart` sets it aside."""
+    """Refuse (one line) a results file of other code or of a newer schema, unless
+    `restart` sets it aside, and one another grid is appending to (as a sweep does)."""
     if not out.exists():
         return
     code = code_version()
     state = scan(out)
     other = state.other_code(code)
+    newer = state.newer_schema(SCHEMA)
+    if newer and not restart:
+        raise UserError(
+            f"{out}:{newer[0]}: a result of schema {newer[1]}, newer than this code's "
+            f"{SCHEMA} (written by newer code, which alone reads it); use another --out, or "
+            "--restart to set the file aside and start over"
+        )
     if other and not restart:
         raise UserError(
             f"{out}: holds runs of other code ({', '.join(other)}; this code is {code}); "
             "use another --out, or --restart to set them aside and start over"
         )
-    if other:
-        tag = next(iter(other)) if len(other) == 1 else "mixed"
+    check_unlocked(out)
+    if other or newer:
+        tag = (next(iter(other)) if len(other) == 1 else "mixed") if other else f"schema{newer[1]}"
         target = out.with_name(f"{out.stem}.{tag}{out.suffix}")
         if target.exists():
             raise UserError(f"{target}: already there; move it away to restart {out}")

@@ -108,6 +108,24 @@ def read_results(path: Path) -> Iterator[RunResult]:
         yield RunResult.from_json(row, f"{path}:{number}")
 
 
+LOCKED = "{path}: another sweep is writing to it; wait for it or use another --out"
+
+
+def check_unlocked(path: Path) -> None:
+    """Refuse, as ResultsWriter would, a results file another writer holds (its lock);
+    takes the lock for a moment and changes nothing (a dry run checks this way)."""
+    try:
+        fd = os.open(path, os.O_RDONLY)
+    except OSError:
+        return  # not there, or not readable: opening it to write will say why
+    try:
+        fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+    except BlockingIOError:
+        raise UserError(LOCKED.format(path=path)) from None
+    finally:
+        os.close(fd)  # closing releases the lock
+
+
 class ResultsWriter(Closing):
     """Appends result lines durably, one writer per file (a lock), torn tail cut off first.
 
@@ -127,9 +145,7 @@ class ResultsWriter(Closing):
             fcntl.flock(self._fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
         except BlockingIOError:
             os.close(self._fd)
-            raise UserError(
-                f"{path}: another sweep is writing to it; wait for it or use another --out"
-            ) from None
+            raise UserError(LOCKED.format(path=path)) from None
         try:
             self.state = scan(path)
         except BaseException:

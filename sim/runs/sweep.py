@@ -21,8 +21,10 @@ finds the same runs (resume) and any executor produces the same results.
 
 from __future__ import annotations
 
+import errno
 import hashlib
 import json
+import os
 import sys
 import time
 import zlib
@@ -33,11 +35,12 @@ from typing import Any, Protocol
 
 from tqdm import tqdm
 
+from monopic.cli.args import output_folder
 from monopic.errors import UserError
 from monopic.output import stale_temporaries_cleared
 from sim.runs.code_version import code_version
 from sim.runs.result import SCHEMA
-from sim.runs.results_file import ResultsWriter, scan
+from sim.runs.results_file import ResultsState, ResultsWriter, check_unlocked, scan
 from sim.runs.run_spec import RunSpec
 from sim.scenario.files import (
     ScenarioFile,
@@ -47,6 +50,7 @@ from sim.scenario.files import (
     is_scenario_file,
     load,
     parse_parameters,
+    unsweepable,
 )
 from sim.scenario.spec import Scenario
 from sim.scenario.toml_table import TomlTable, read_toml
@@ -126,6 +130,11 @@ def parse_spec(
                     key, value, f'draws at random only: sampling = "{sampling}" would ignore it'
                 )
         parameters = parse_parameters(entry, need_steps=sampling in ("grid", "base"))
+        for key in parameters:
+            reason = unsweepable(key)  # a file's own [sweep.parameters] obey the same rule
+            if reason is not None:
+                field = f"{entry.field('parameters')}.{key}"
+                raise ScenarioFileError(path, field, entry.data["parameters"][key], reason)
         entry.done()
         includes.append(Include(tuple(files), sampling, runs, seed, parameters))
     top.done()
@@ -227,7 +236,7 @@ def expand_spec(spec: SweepSpec) -> list[RunSpec]:
                         family=file.family,
                         file=str(path),
                         kind=file.kind,
-                        scale=file.scale.value,
+                        scale=str(params.get("scale", file.scale.value)),  # swept: applied
                         params={k: _plain(v) for k, v in params.items()},
                         sweep=spec.name,
                         ablation=spec.ablation,
@@ -258,21 +267,122 @@ def recordings_folder(out: Path, record_dir: Path | None = None) -> Path:
     return record_dir if record_dir is not None else out.parent / f"{out.stem}_rrd"
 
 
-def set_aside(out: Path, folder: Path, tag: str) -> None:
-    """Rename a stale results file and its recordings folder to <name>.<tag>..., refusing
-    to overwrite an earlier one."""
+def aside_moves(out: Path, folder: Path, tag: str) -> list[tuple[Path, Path]]:
+    """Where set_aside moves a stale results file and its recordings folder
+    (<name>.<tag>...); an earlier one already there is refused, never overwritten."""
     moves = [(out, out.with_name(f"{out.stem}.{tag}{out.suffix}"))]
     if folder.exists():
         moves.append((folder, folder.with_name(f"{folder.name}.{tag}")))
     for _, target in moves:
         if target.exists():
             raise UserError(f"{target}: already there; move it away to restart {out}")
+    return moves
+
+
+def set_aside(moves: list[tuple[Path, Path]]) -> None:
+    """Rename a stale results file and its recordings folder (aside_moves)."""
     for source, target in moves:
         try:
             source.rename(target)
         except OSError as err:
             raise UserError(f"{source}: cannot set it aside ({err.strerror or err})") from None
         print(f"set aside: {source} -> {target}", file=sys.stderr)
+
+
+@dataclass(frozen=True)
+class OutputCheck:
+    """What a sweep found at its output before its first run (check_output)."""
+
+    state: ResultsState | None  # the results file as it stands (None: not there yet)
+    folder: Path  # where the recordings go
+    moves: tuple[tuple[Path, Path], ...] = ()  # --restart: what is set aside first
+
+    @property
+    def done(self) -> frozenset[str]:
+        """The ids the sweep will find there (none when the file is set aside)."""
+        return self.state.ids if self.state is not None and not self.moves else frozenset()
+
+
+def check_output(
+    spec: SweepSpec,
+    out: Path,
+    record: str = "failed",
+    record_dir: Path | None = None,
+    restart: bool = False,
+) -> OutputCheck:
+    """Every check a sweep makes on its output before its first run; the dry run calls it
+    too, so it refuses what the run refuses, with the same line, and changes nothing.
+
+    The results path (a file, in a folder that can be made, writable), what the file holds
+    (whole lines; another sweep's runs, other code's, a newer schema: refused unless
+    `restart` sets the file aside), another sweep appending to it (its lock) and the
+    recordings folder (it can be made, unless `record` is "none")."""
+    if out.is_dir():
+        raise UserError(f"--out {out}: is a folder; give a file name")
+    _check_makeable(out.parent, f"--out {out.parent}: a file is in the way of this folder")
+    _check_writable(out, "{path}: cannot write there ({reason}); use another --out")
+    code = sweep_code(spec)
+    folder = recordings_folder(out, record_dir)
+    state = scan(out) if out.exists() else None
+    other = state.other_code(code) if state else None
+    newer = state.newer_schema(SCHEMA) if state else None
+    if newer and not restart:
+        line, schema = newer
+        raise UserError(
+            f"{out}:{line}: a result of schema {schema}, newer than this code's {SCHEMA} "
+            "(written by newer code, which alone reads it); to redo its runs with this code, "
+            "use another --out, or --restart to set the file aside and start over"
+        )
+    mixed = state.other_sweeps(spec.name) if state else None
+    if mixed and not restart:
+        names = ", ".join(f"{n!r} ({k} run{'' if k == 1 else 's'})" for n, k in mixed.most_common())
+        raise UserError(
+            f"{out}: holds runs of another sweep ({names}), not of {spec.name!r}; a results "
+            "file holds one sweep, so give this one another --out (or --restart to set that "
+            "file aside and start over)"
+        )
+    if other and not restart:
+        versions = ", ".join(f"{n} by {c}" for c, n in other.most_common())
+        raise UserError(
+            f"{out}: holds runs of other code ({versions}; this code is {code}), and a "
+            "sweep resumes only its own code's runs; use another --out, or --restart to "
+            "set the old results aside and start over"
+        )
+    check_unlocked(out)
+    moves: list[tuple[Path, Path]] = []
+    if mixed:
+        moves = aside_moves(out, folder, mixed.most_common(1)[0][0])
+    elif other or newer:
+        tag = other.most_common(1)[0][0] if other and len(other) == 1 else "mixed"
+        moves = aside_moves(out, folder, tag if other else f"schema{newer[1]}")
+    if record != "none":
+        message = (
+            "{path}: cannot make the recordings folder ({reason}); use --recordings DIR or "
+            "--record none"
+        )
+        _check_makeable(folder, message.format(path=folder, reason="a file is in the way"))
+        _check_writable(folder, message)
+    return OutputCheck(state, folder, tuple(moves))
+
+
+def _check_makeable(folder: Path, message: str) -> None:
+    """`mkdir -p folder` would not meet a file on its way (`message` if it would)."""
+    for part in (folder, *folder.parents):
+        if part.exists():
+            if not part.is_dir():
+                raise UserError(message)
+            return
+
+
+def _check_writable(path: Path, message: str) -> None:
+    """`path` (or, while it is not there, the nearest folder it would be made in) can be
+    written; `message` takes {path} and {reason} (as the error the write would raise)."""
+    target = next(p for p in (path, *path.parents) if p.exists())
+    if os.access(target, os.W_OK):
+        return
+    readonly = os.statvfs(target).f_flag & os.ST_RDONLY
+    reason = os.strerror(errno.EROFS if readonly else errno.EACCES)
+    raise UserError(message.format(path=path, reason=reason))
 
 
 def sweep_code(spec: SweepSpec) -> str:
@@ -316,44 +426,14 @@ def run_sweep(
     start and after the workers are gone, however the sweep ends: a worker stopped
     mid-run dies without deleting the recording it was writing.
     """
-    code = sweep_code(spec)
     runs = expand_spec(spec)
     if ablation is not None:
         runs = [replace(r, ablation=ablation) for r in runs]
-    folder = recordings_folder(out, record_dir)
-    runs = [replace(r, record=record, record_dir=str(folder), code=code) for r in runs]
-    if not out.parent.is_dir():
-        raise UserError(f"{out}: its folder {out.parent} does not exist")
-    state = scan(out) if out.exists() else None
-    other = state.other_code(code) if state else None
-    newer = state.newer_schema(SCHEMA) if state else None
-    if newer and not restart:
-        line, schema = newer
-        raise UserError(
-            f"{out}:{line}: a result of schema {schema}, newer than this code's {SCHEMA} "
-            "(written by newer code, which alone reads it); to redo its runs with this code, "
-            "use another --out, or --restart to set the file aside and start over"
-        )
-    mixed = state.other_sweeps(spec.name) if state else None
-    if mixed and not restart:
-        names = ", ".join(f"{n!r} ({k} run{'' if k == 1 else 's'})" for n, k in mixed.most_common())
-        raise UserError(
-            f"{out}: holds runs of another sweep ({names}), not of {spec.name!r}; a results "
-            "file holds one sweep, so give this one another --out (or --restart to set that "
-            "file aside and start over)"
-        )
-    if other and not restart:
-        versions = ", ".join(f"{n} by {c}" for c, n in other.most_common())
-        raise UserError(
-            f"{out}: holds runs of other code ({versions}; this code is {code}), and a "
-            "sweep resumes only its own code's runs; use another --out, or --restart to "
-            "set the old results aside and start over"
-        )
-    if mixed:
-        set_aside(out, folder, mixed.most_common(1)[0][0])
-    elif other or newer:
-        tag = other.most_common(1)[0][0] if other and len(other) == 1 else "mixed"
-        set_aside(out, folder, tag if other else f"schema{newer[1]}")
+    check = check_output(spec, out, record, record_dir, restart)
+    folder = check.folder
+    runs = [replace(r, record=record, record_dir=str(folder), code=sweep_code(spec)) for r in runs]
+    output_folder(out.parent, "--out")
+    set_aside(list(check.moves))
     # The lock held, no other sweep of this results file writes recordings: the
     # temporaries found in its folder are a killed sweep's, or being written by a sweep
     # of another results file sharing the folder (its processes run: kept).

@@ -183,15 +183,6 @@ def _out_of_range(value: float, meta: Mapping[str, Any], high: float | None) -> 
 PLACEMENT_FIELDS = {f.name: f for f in fields(CasePlacement) if f.name != "case"}
 
 
-def placement_help(name: str) -> str:
-    """A parameter's meaning, unit, range and default, for --help and the docs."""
-    meta, default = PLACEMENT_FIELDS[name].metadata, PLACEMENT_FIELDS[name].default
-    high = "" if meta["high"] is None else f"{meta['high']:g}"
-    unit = f" {meta['unit']}" if meta["unit"] else ""
-    shown = "mid-run" if default is None else f"{default:g}"
-    return f"{meta['doc']} ([{meta['low']:g}, {high}]{unit}; default {shown})"
-
-
 def default_crossing() -> Scenario:
     """An adult crossing from the left into the robot's path: contact at 2.7 s unless it brakes."""
     placement = CasePlacement(

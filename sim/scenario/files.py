@@ -13,7 +13,7 @@ from __future__ import annotations
 import copy
 import math
 import zlib
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -248,6 +248,21 @@ class ScenarioFile:
             ) from None
         return replace(scenario, name=name, seed=scenario.seed if seed is None else seed)
 
+    def with_given(self, given: Sequence[Given], name: str | None = None) -> Scenario:
+        """The scenario with values given on the command line, checked as the file's own.
+
+        An option that cannot apply to this file (given_problem) or a value the file's
+        checks refuse is one line naming the options, then the file's field and reason."""
+        for g in given:
+            problem = given_problem(self.data, g)
+            if problem is not None:
+                raise UserError(f"{g.text}: {self.path}: {problem}")
+        try:
+            scenario = build(self.path, with_values(self.data, {g.key: g.value for g in given}))
+        except ScenarioFileError as err:
+            raise UserError(f"{' '.join(g.text for g in given)}: {err}") from None
+        return replace(scenario, name=name or self.name)
+
     def runs(self) -> Iterator[dict[str, Any]]:
         return expand(self.sweep, self.name)
 
@@ -294,8 +309,9 @@ def load(path: Path | str) -> ScenarioFile:
 def _check_parameters(path: Path, data: dict[str, Any], sweep: Sweep) -> None:
     """Every value of every parameter must build on its own (type, range, known key)."""
     for key, dist in sweep.parameters.items():
-        if key.split(".")[0] in ("sweep", "name", "family", "kind", "scale"):
-            raise ScenarioFileError(path, f"sweep.parameters.{key}", MISSING, "cannot be swept")
+        reason = unsweepable(key)
+        if reason is not None:
+            raise ScenarioFileError(path, f"sweep.parameters.{key}", MISSING, reason)
         values = dist.grid() if isinstance(dist, Values) or dist.steps else (dist.low, dist.high)
         for value in values:
             try:
@@ -308,6 +324,129 @@ def _check_parameters(path: Path, data: dict[str, Any], sweep: Sweep) -> None:
                 # Other failures depend on the combination; the sweep checks each run.
             except ValueError as err:
                 raise ScenarioFileError(path, f"sweep.parameters.{key}", value, str(err)) from None
+
+
+# Keys that label a file's runs rather than describe its scenario: the runs keep the
+# file's own (its results, its report row, its run ids), so a sweep cannot vary them.
+LABEL_KEYS = ("name", "family", "kind", "description", "sweep")
+
+
+def unsweepable(key: str) -> str | None:
+    """Why a dotted key cannot be swept; None when every run applies it to its scenario.
+
+    The one rule for a scenario file's [sweep.parameters] and a sweep spec's
+    [include.parameters]."""
+    top = key.split(".")[0]
+    if top not in LABEL_KEYS:
+        return None
+    if top == "sweep":
+        return "cannot be swept: [sweep] says how the file is swept, it is not a scenario value"
+    return (
+        f"cannot be swept: the file's {top} labels all its runs (their results and the "
+        f"report keep it); to vary it, write one scenario file per {top}"
+    )
+
+
+# -- values given on the command line -------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Given:
+    """A value given on the command line for a key of a scenario file (record's --robot-speed
+    for robot.speed, closed-loop's --speeds ...): applied as the file's own value would be."""
+
+    option: str  # as typed, e.g. "--robot-speed"
+    key: str  # the file's dotted key, e.g. "robot.speed"
+    value: Any
+
+    @property
+    def text(self) -> str:
+        """The option and its value as a refusal names them, e.g. `--robot-speed 10`."""
+        shown = f"{self.value:g}" if isinstance(self.value, float) else str(self.value)
+        return f"{self.option} {shown}"
+
+
+def given_problem(data: Mapping[str, Any], g: Given) -> str | None:
+    """Why a value given on the command line cannot apply to the scenario of `data` (None:
+    it applies): a case placement's keys need a case path, a standing person has no speed."""
+    path = data.get("path") if isinstance(data.get("path"), dict) else {}
+    kind = path.get("kind")
+    if g.key.startswith("path.") and kind != "case":
+        return (
+            f"{g.key} is a case placement's (path.kind = 'case'); this file's path.kind is "
+            f"{show(kind)}, which has no {g.key.removeprefix('path.')}"
+        )
+    if g.key == "pedestrian.speed" and kind == "case" and path.get("case") == int(Case.STILL):
+        return "case 9 (still) stands: it has no walking speed"
+    return None
+
+
+def scene_data(scene: SceneSpec) -> dict[str, Any]:
+    """[scene] of a scenario file that builds `scene` (its occluders aside)."""
+    road = scene.road
+    return {
+        "sun_azimuth_deg": scene.sun_azimuth_deg,
+        "sun_elevation_deg": scene.sun_elevation_deg,
+        "lighting": "noon" if scene.shadows else "overcast",
+        "road": {
+            "length": road.length,
+            "lanes": road.lanes,
+            "lane_width": road.lane_width,
+            "center_y": road.center_y,
+            "pavement_width": road.pavement_width,
+            "crosswalk": road.crosswalk_x is not None,
+            **({} if road.crosswalk_x is None else {"crosswalk_x": road.crosswalk_x}),
+            "buildings": road.buildings,
+        },
+    }
+
+
+# The street of a case placed on the command line: SceneSpec's, the one every placement
+# (CasePlacement.scenario) stands in, with the robot on the road's centre line; the robot,
+# its camera, its max_speed and the horizon are the small scale's.
+PLACED_SCENE = SceneSpec()
+PLACED_FILE = Path("<command line>")
+
+
+def placed_case(
+    case: Case,
+    given: Sequence[Given],
+    fixed: Mapping[str, Any] | None = None,
+    name: str | None = None,
+    where: str = "",
+) -> Scenario:
+    """A case placed on the command line, built as the small-scale scenario file with
+    path.kind = "case" and these values would be: the same checks, the same Scenario.
+
+    `fixed` are the command's own values (dotted keys), `given` the user's. A refusal is
+    one line naming the option that set the field (`--robot-speed 10: must be <= 3 m/s
+    ...`); for a check of the values together (the street, the road's end) every option
+    given; otherwise the options given, `where` (e.g. "case 5: ") and the field."""
+    data: dict[str, Any] = {
+        "name": name or f"case{int(case)}-{case.label.replace(' ', '-')}",
+        "family": "cases",
+        "scale": Scale.SMALL.value,
+        "scene": scene_data(PLACED_SCENE),
+        "path": {"kind": "case", "case": int(case)},
+    }
+    data = with_values(data, {**(fixed or {}), **{g.key: g.value for g in given}})
+    for g in given:
+        problem = given_problem(data, g)
+        if problem is not None:
+            raise UserError(f"{g.text}: {where}{problem}")
+    try:
+        return build(PLACED_FILE, data)
+    except StreetError as err:  # the values together: name them all, and where it happens
+        at = f"; at {show(err.value)}" if err.field == "path" else ""
+        line = f"{where}{err.reason}{at}"
+        raise UserError(f"{' '.join(g.text for g in given)}: {line}" if given else line) from None
+    except ScenarioFileError as err:
+        for g in given:
+            if g.key == err.field:
+                raise UserError(f"{g.text}: {where}{err.reason}") from None
+        value = f" = {show(err.value)}" if err.value is not MISSING else ""
+        line = f"{where}{err.field}{value}: {err.reason}"
+        raise UserError(f"{' '.join(g.text for g in given)}: {line}" if given else line) from None
 
 
 # -- building a Scenario from a file's data -------------------------------------------
@@ -412,8 +551,11 @@ def _behaviour(t: TomlTable) -> Behaviour:
 
 def _robot(t: TomlTable, preset: RobotSpec) -> RobotSpec:
     max_speed = t.number("max_speed", preset.max_speed, positive=True, high=40.0, unit="m/s")
+    speed = t.number("speed", preset.speed, low=0.0, unit="m/s")
+    if speed > max_speed:
+        raise t.error("speed", speed, f"must be <= {max_speed:g} m/s (robot.max_speed)")
     robot = RobotSpec(
-        speed=t.number("speed", preset.speed, low=0.0, high=max_speed, unit="m/s"),
+        speed=speed,
         width=t.number("width", preset.width, positive=True, high=3.0, unit="m"),
         length=t.number("length", preset.length, positive=True, high=12.0, unit="m"),
         camera=_camera(t.table("camera"), preset.camera),
@@ -645,11 +787,15 @@ def _parked_cars(
     return cars
 
 
+class StreetError(ScenarioFileError):
+    """A check of the whole scenario (street_problem): no single value is to blame."""
+
+
 def _check_on_street(path: Path, s: Scenario) -> None:
     """The robot stays on its road and the pedestrian on the street for the whole run."""
     problem = street_problem(s)
     if problem is not None:
-        raise ScenarioFileError(path, problem.field, problem.value, problem.reason)
+        raise StreetError(path, problem.field, problem.value, problem.reason)
 
 
 def street_problem(s: Scenario) -> PlacementError | None:

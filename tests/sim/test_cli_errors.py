@@ -4,12 +4,17 @@ from __future__ import annotations
 
 import os
 import tomllib
+from dataclasses import replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
 
 from monopic.cli.main import main
 from tests.paths import SCENARIOS
+
+if TYPE_CHECKING:
+    from sim.scenario.spec import Scenario
 
 CASE5 = SCENARIOS / "cases" / "case5_perpendicular_right.toml"
 DEMO = SCENARIOS / "sweeps" / "demo.toml"
@@ -166,8 +171,11 @@ def test_dry_run_shows_runs_per_family_and_a_time_it_says_how_it_computed(
     )
     assert not out.exists()  # a dry run writes nothing
     # Finished runs in the results file replace the benchmark's figure by their own.
-    rows = [{"id": "x/1", "frames": 10, "timing": {"wall_s": 3.0}},
-            {"id": "x/2", "frames": 30, "timing": {"wall_s": 5.0}}]  # fmt: skip
+    from sim.runs.sweep import load_spec, sweep_code
+
+    mine = {"sweep": "t", "code": sweep_code(load_spec(spec))}  # else the run would refuse it
+    rows = [{"id": "x/1", "frames": 10, "timing": {"wall_s": 3.0}, **mine},
+            {"id": "x/2", "frames": 30, "timing": {"wall_s": 5.0}, **mine}]  # fmt: skip
     out.write_text("".join(json.dumps(r) + "\n" for r in rows))
     assert main(["sweep", str(spec), "--out", str(out), "--dry-run", "--no-ablation"]) == 0
     time_line = capsys.readouterr().out.splitlines()[4]
@@ -227,8 +235,10 @@ def test_report_of_a_file_that_is_not_a_results_file_says_so(
             40.0,
             "the pedestrian's path leaves the street",
         ),
-        ("--robot-speed", "robot.speed", 25.0, "must be <= 20 m/s"),
+        ("--robot-speed", "robot.speed", 3.5, "must be <= 3 m/s (robot.max_speed)"),
         ("--duration", "duration", 0.0, "must be > 0 s"),
+        ("--pedestrian-speed", "pedestrian.speed", 0.2, "must be >= 0.3 m/s"),
+        ("--seed", "seed", -1, "must be an integer in [0, 2147483647]"),
     ],
 )
 def test_record_checks_a_case_as_a_scenario_file_checks_it(
@@ -243,8 +253,8 @@ def test_record_checks_a_case_as_a_scenario_file_checks_it(
     from sim.scenario.files import build, with_values
     from sim.scenario.toml_table import FieldError
 
-    # Case 5 as a file, with the command's robot (RobotSpec's limits: 20 m/s).
-    text = CASE5.read_text().split("[sweep]")[0].replace("[robot]", "[robot]\nmax_speed = 20.0")
+    # Case 5 as a file: small scale, the command's robot (max_speed 3 m/s).
+    text = CASE5.read_text().split("[sweep]")[0]
     with pytest.raises(FieldError) as in_file:
         build(CASE5, with_values(tomllib.loads(text), {key: value}))
     assert reason in in_file.value.reason
@@ -270,6 +280,159 @@ def test_the_executor_options_refuse_what_they_cannot_apply(
     assert main([command, str(DEMO), "--out", str(out), *options]) == 2
     assert expected in one_line_error(capsys)
     assert not out.exists()
+
+
+def record_scenario(*argv: str) -> Scenario:
+    """The Scenario `monopic record ARGV` would run (its arguments parsed as the CLI does)."""
+    from monopic.cli.main import build_parser
+    from sim.commands.record import resolve_scenario
+
+    args = build_parser().parse_args(["record", *argv])
+    return resolve_scenario(args.scenario, args)
+
+
+def test_a_case_on_the_command_line_is_the_placement_with_the_small_robots_limit() -> None:
+    """Placed as a small-scale file is, a case is the scenario CasePlacement gives, with the
+    one difference the file's checks make: the small robot's max_speed, 3 m/s (not 20)."""
+    from monopic.cases import Case
+    from sim.scenario.cases import CasePlacement
+
+    for case in Case:
+        before = CasePlacement(case).scenario()
+        small = replace(before, robot=replace(before.robot, max_speed=3.0))
+        assert record_scenario(str(int(case))) == small, case
+    values = ["--distance", "5", "--lateral-offset", "1.5", "--pedestrian-speed", "1.1",
+              "--robot-speed", "1.5", "--duration", "3", "--seed", "4"]  # fmt: skip
+    placed = CasePlacement(Case.OBLIQUE_LEFT_TOWARD, distance=5.0, lateral_offset=1.5,
+                           pedestrian_speed=1.1, robot_speed=1.5, duration=3.0, seed=4)  # fmt: skip
+    before = placed.scenario()
+    assert record_scenario("4", *values) == replace(
+        before, robot=replace(before.robot, max_speed=3.0)
+    )
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        # above the small robot's max_speed (RobotSpec's 20 m/s let it run at 10)
+        (["5", "--robot-speed", "10"], "--robot-speed 10: must be <= 3 m/s (robot.max_speed)"),
+        # off the end of the road within the run: both values named
+        (
+            ["9", "--robot-speed", "3", "--duration", "40"],
+            "--robot-speed 3 --duration 40: the robot would drive off the end of the road "
+            "within the run (120.4 m > 120.0 m): lower the speed or the duration",
+        ),
+        # the pedestrian off the street, with where it leaves
+        (
+            ["5", "--lateral-offset", "6"],
+            "--lateral-offset 6: the pedestrian's path leaves the street (x in [-120, 120] m, "
+            "y in [-6.65, 6.65] m); at {t = 0.0, x = 8.0, y = 8.8}",
+        ),
+        # each placement range
+        (["5", "--distance", "-0.5"], "--distance -0.5: must be >= 0 m"),
+        (["9", "--distance", "201"], "--distance 201: must be <= 200 m"),
+        (["5", "--pedestrian-speed", "0.29"], "--pedestrian-speed 0.29: must be >= 0.3 m/s"),
+        (["8", "--pedestrian-speed", "10.5"], "--pedestrian-speed 10.5: must be <= 10 m/s"),
+        (["5", "--robot-speed", "-1"], "--robot-speed -1: must be >= 0 m/s"),
+        (["5", "--duration", "0"], "--duration 0: must be > 0 s"),
+        (["9", "--duration", "61"], "--duration 61: must be <= 60 s"),
+        (["5", "--seed", "2147483648"], "--seed 2147483648: must be an integer in [0, 2147483647]"),
+        # a value that cannot apply is refused, not dropped
+        (["9", "--pedestrian-speed", "2"], "--pedestrian-speed 2: case 9 (still) stands"),
+        (["crossing", "--seed", "3"], "--seed 3: 'crossing' is a fixed scenario"),
+    ],
+)
+def test_each_check_a_case_on_the_command_line_gets(argv: list[str], expected: str) -> None:
+    from monopic.errors import UserError
+
+    with pytest.raises(UserError) as err:
+        record_scenario(*argv)
+    assert str(err.value).startswith(expected), str(err.value)
+
+
+def _help_ranges() -> dict[str, tuple[str, float, float, str]]:
+    """Each case option's range as `monopic record --help` states it: (opening bracket, low,
+    high, its text)."""
+    import re
+
+    from monopic.cli.main import build_parser
+
+    record = build_parser()._subparsers._group_actions[0].choices["record"]  # type: ignore[union-attr]
+    out = {}
+    for action in record._actions:
+        option = action.option_strings[0] if action.option_strings else ""
+        if option in ("--distance", "--lateral-offset", "--pedestrian-speed", "--robot-speed",
+                      "--duration", "--seed"):  # fmt: skip
+            found = re.search(r"([\[(])(-?[\d.]+), (-?[\d.]+)\]", action.help or "")
+            assert found, (option, action.help)
+            out[option] = (found[1], float(found[2]), float(found[3]), action.help or "")
+    return out
+
+
+# For each option, other values that leave the option's own range as the only limit: a
+# standing person (case 9) on a standing robot, or (walking speeds) one walking along the
+# robot's path for a short run.
+RANGE_CONTEXT = {
+    "--distance": ["9", "--robot-speed", "0"],
+    "--lateral-offset": ["9", "--robot-speed", "0"],
+    "--pedestrian-speed": ["8", "--distance", "30", "--duration", "1"],
+    "--robot-speed": ["9", "--duration", "1"],
+    "--duration": ["9", "--robot-speed", "0"],
+    "--seed": ["5"],
+}
+
+
+@pytest.mark.parametrize("option", list(RANGE_CONTEXT))
+def test_record_help_states_the_ranges_it_checks(option: str) -> None:
+    """Just inside each end of the range --help states is accepted, just outside refused
+    with one line naming the option; the default --help states is the one applied."""
+    from monopic.errors import UserError
+
+    opening, low, high, text = _help_ranges()[option]
+    integer = option == "--seed"
+    step = 1 if integer else 0.01
+    inside = [low + step if opening == "(" else low, high]
+    outside = [low if opening == "(" else low - step, high + step]
+    context = RANGE_CONTEXT[option]
+    for value in inside:
+        shown = str(int(value)) if integer else f"{value:g}"
+        record_scenario(*context, option, shown)
+    for value in outside:
+        shown = str(int(value)) if integer else f"{value:g}"
+        with pytest.raises(UserError) as err:
+            record_scenario(*context, option, shown)
+        assert str(err.value).startswith(f"{option} {shown}"), str(err.value)
+    default = text.rsplit("default ", 1)[1]
+    assert record_scenario(*context, option, default) == record_scenario(*context)
+
+
+def test_record_applies_a_files_own_values_and_refuses_what_cannot_apply(
+    capsys: pytest.CaptureFixture[str],
+) -> None:
+    """Options given with a scenario file replace its values, through its checks; without
+    them the file's own apply."""
+    car = SCENARIOS / "families" / "car" / "cpna25.toml"  # a crossing at 8.33 m/s
+    base = record_scenario(str(car))
+    assert base.robot.speed == 8.33
+    given = record_scenario(str(car), "--robot-speed", "5", "--duration", "5", "--seed", "7",
+                            "--pedestrian-speed", "1.2")  # fmt: skip
+    assert (given.robot.speed, given.duration, given.seed) == (5.0, 5.0, 7)
+    assert given.pedestrian.speed == 1.2 and given.name == base.name
+    # A case placement's options on a case file; on a crossing, one line.
+    placed = record_scenario(str(CASE5), "--distance", "6", "--lateral-offset", "0.5")
+    assert placed.pedestrian.anchor is not None
+    assert (placed.pedestrian.anchor.x, placed.pedestrian.anchor.y) == (6.0, 0.5)
+    argv = ["record", str(car), "--distance", "6"]
+    assert main(argv) == 2
+    assert one_line_error(capsys) == (
+        f"monopic record: error: --distance 6: {car}: path.distance is a case placement's "
+        "(path.kind = 'case'); this file's path.kind is 'crossing', which has no distance"
+    )
+    assert main(["record", str(car), "--robot-speed", "25"]) == 2
+    assert one_line_error(capsys) == (
+        f"monopic record: error: --robot-speed 25: {car}: robot.speed = 25.0: must be <= "
+        "20 m/s (robot.max_speed)"
+    )
 
 
 def test_ray_log_lines_go_above_the_progress_bar_not_into_it(
@@ -342,3 +505,39 @@ def test_output_piped_into_a_reader_that_stops_early_ends_quietly() -> None:
     proc = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert proc.returncode == 141, proc.stderr
     assert "Traceback" not in proc.stderr and "BrokenPipeError" not in proc.stderr
+
+
+def test_a_dataset_estimate_refuses_what_the_build_refuses_with_the_same_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import json
+
+    import sim.dataset.build
+
+    def no_render(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a run was rendered before the folder was checked")
+
+    monkeypatch.setattr(sim.dataset.build, "render_run", no_render)
+    (tmp_path / "tiny.toml").write_text(TINY.split("[sweep]")[0])
+    spec = tmp_path / "spec.toml"
+    spec.write_text('name = "t"\n[[include]]\nfiles = ["tiny.toml"]\nsampling = "base"\n')
+    a_file = tmp_path / "a_file"
+    a_file.write_text("x")
+    other = tmp_path / "other"
+    other.mkdir()
+    (other / "notes.txt").write_text("x")
+    another = tmp_path / "another"
+    another.mkdir()
+    (another / "dataset.json").write_text(json.dumps({"name": "o", "spec_digest": "0"}))
+    for out, expected in [
+        (a_file, f"--out {a_file}: is a file, not a dataset folder"),
+        (a_file / "ds", f"--out {a_file}: a file is in the way of this folder"),
+        (other, f"{other}: exists and is not empty (and is not a dataset of this spec)"),
+        (another, f"{another}: holds dataset 'o' made from another spec (digest 0 vs "),
+    ]:
+        lines = []
+        for estimate in (["--estimate-only"], []):
+            assert main(["dataset", str(spec), "--out", str(out), *estimate]) == 2
+            lines.append(one_line_error(capsys))
+        assert lines[0] == lines[1]
+        assert lines[0].startswith(f"monopic dataset: error: {expected}"), lines[0]

@@ -91,6 +91,18 @@ def test_braking_on_the_ground_mode_warning_avoids_contacts():
         ),
         (["--cases", "5", "--policies", "rules/sky"], "'rules/sky' is not a policy"),
         (["--cases", "5", "--speeds", "fast"], "--speeds: expected numbers"),
+        # a case placement gets a small-scale file's checks: the small robot's max_speed
+        (["--cases", "5", "--speeds", "10"], "--speeds 10: case 5: must be <= 3 m/s"),
+        # a file's own max_speed, named with the option and the file
+        (
+            ["scenarios/families/car/cpna25.toml", "--speeds", "25"],
+            "--speeds 25: scenarios/families/car/cpna25.toml: robot.speed = 25.0: must be "
+            "<= 20 m/s (robot.max_speed)",
+        ),
+        (
+            ["scenarios/families/car/cpna25.toml", "--seed", "-2"],
+            "--seed -2: scenarios/families/car/cpna25.toml: seed = -2: must be an integer",
+        ),
     ],
 )
 def test_closed_loop_command_rejects_bad_input_in_one_line(capsys, monkeypatch, argv, expected):
@@ -103,3 +115,46 @@ def test_closed_loop_command_rejects_bad_input_in_one_line(capsys, monkeypatch, 
     assert main(["closed-loop", *argv]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and expected in err
+
+
+CAR_FILE = """
+name = "child-at-30"
+scale = "car"
+duration = 1.0
+seed = 5
+[robot]
+speed = 8.33
+[robot.camera]
+width = 256
+height = 144
+[path]
+kind = "case"
+case = 5
+distance = 4.0
+"""
+
+
+def test_a_file_runs_at_its_own_speed_and_seed_unless_given(tmp_path):
+    """closed-loop FILE: the file's robot.speed and seed are the defaults; --speeds and
+    --seed replace them (the default families too: each at its own speed and seed)."""
+    from sim.commands.closed_loop import FAMILY_FOLDER, NCAP_FAMILIES, file_scenarios
+    from sim.scenario.files import load
+
+    path = tmp_path / "car.toml"
+    path.write_text(CAR_FILE)
+    table = tmp_path / "table.md"
+    assert main(["closed-loop", str(path), "--policies", "none", "--out", str(table)]) == 0
+    text = table.read_text()
+    assert "1 scenarios" in text and "robot speeds 8.33 m/s: each file's own" in text
+    assert "seed 5 (each file's own)" in text
+    assert "| child-at-30@8.33 | none | yes | 8.33 |" in text  # hit at the file's speed
+    given = file_scenarios([path], [4.0, 6.0], 9)
+    assert [(s.name, s.robot.speed, s.seed) for s in given] == [
+        ("child-at-30@4", 4.0, 9),
+        ("child-at-30@6", 6.0, 9),
+    ]
+    families = [FAMILY_FOLDER / f"{name}.toml" for name in NCAP_FAMILIES]
+    own = file_scenarios(families, None, None)
+    assert [(s.robot.speed, s.seed) for s in own] == [
+        (load(f).base.robot.speed, load(f).base.seed) for f in families
+    ]

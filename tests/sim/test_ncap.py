@@ -205,3 +205,29 @@ def test_ncap_command_runs_scores_and_resumes(tmp_path, capsys):
     capsys.readouterr()
     assert main(argv) == 0  # resumes: nothing to run again
     assert "2 of 2 runs already there" in capsys.readouterr().err
+
+
+def test_a_results_file_of_a_newer_schema_or_being_written_is_refused_in_one_line(tmp_path):
+    """The grid's results file gets the sweep's checks: a newer schema (this code would
+    misread it) is refused unless --restart sets it aside; one another grid is appending to
+    is refused before anything is set aside."""
+    import json
+
+    from monopic.errors import UserError
+    from sim.runs.code_version import code_version
+    from sim.runs.ncap_grid import check_results
+    from sim.runs.results_file import ResultsWriter
+
+    out = tmp_path / "results.jsonl"
+    out.write_text(json.dumps({"id": "a", "code": code_version(), "schema": 99}) + "\n")
+    with pytest.raises(UserError) as err:
+        check_results(out, restart=False)
+    assert str(err.value).startswith(f"{out}:1: a result of schema 99, newer than this code's 1")
+    with ResultsWriter(out), pytest.raises(UserError) as err:
+        check_results(out, restart=True)
+    assert str(err.value) == (
+        f"{out}: another sweep is writing to it; wait for it or use another --out"
+    )
+    assert out.exists()
+    check_results(out, restart=True)
+    assert not out.exists() and (tmp_path / "results.schema99.jsonl").exists()

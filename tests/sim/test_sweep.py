@@ -456,3 +456,169 @@ def test_the_shipped_trees_judged_spec_draws_intent_judged_e_s_runs() -> None:
     assert shipped_spec.intent_tree == (ROOT / "monopic" / "tree" / "ground_tree.json").resolve()
     assert len(shipped) == len(judged) == 4 * 128 + 3 * 32
     assert [(r.id, r.scenario) for r in shipped] == [(r.id, r.scenario) for r in judged]
+
+
+LABELS = [
+    ("kind", '["near-miss"]', "['near-miss']"),
+    ("family", '["cpna-25"]', "['cpna-25']"),
+    ("name", '["other"]', "['other']"),
+    ("description", '["x"]', "['x']"),
+]
+
+
+@pytest.mark.parametrize(("key", "toml", "shown"), LABELS, ids=[k for k, _, _ in LABELS])
+def test_a_sweep_parameter_the_run_does_not_apply_is_refused_when_the_spec_is_read(
+    tmp_path: Path, key: str, toml: str, shown: str
+) -> None:
+    """kind, family, name, description label a file's runs: swept, the runs kept the file's
+    (a near miss counted as a collision). One rule for [include.parameters] and a file's
+    own [sweep.parameters]."""
+    from sim.scenario.files import load
+
+    (tmp_path / "tiny.toml").write_text(SCENARIO)
+    spec = tmp_path / "spec.toml"
+    spec.write_text(SPEC.format(ablation="false") + f"[include.parameters]\n{key} = {toml}\n")
+    reason = (
+        f"cannot be swept: the file's {key} labels all its runs (their results and the "
+        f"report keep it); to vary it, write one scenario file per {key}"
+    )
+    with pytest.raises(UserError) as err:
+        load_spec(spec)
+    assert str(err.value) == f"{spec}: include[0].parameters.{key} = {shown}: {reason}"
+    (tmp_path / "own.toml").write_text(SCENARIO + f"{key} = {toml}\n")
+    with pytest.raises(UserError) as err:
+        load(tmp_path / "own.toml")
+    assert str(err.value) == f"{tmp_path / 'own.toml'}: sweep.parameters.{key}: {reason}"
+
+
+def test_a_swept_scale_is_the_scale_of_the_run_its_results_and_its_dry_run(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    """`scale` swept changes the scenario (robot, road, horizon): its run, result row and
+    the dry run carry the swept scale, not the file's."""
+    (tmp_path / "tiny.toml").write_text(SCENARIO)
+    spec = tmp_path / "spec.toml"
+    spec.write_text(
+        SPEC.format(ablation="false")
+        + 'sampling = "base"\n[include.parameters]\nscale = ["small", "car"]\n'
+    )
+    runs = expand_spec(load_spec(spec))
+    assert [(r.scale, r.params, r.scenario.robot.width) for r in runs] == [
+        ("small", {"scale": "small"}, 0.6),
+        ("car", {"scale": "car"}, 1.8),
+    ]
+    out = tmp_path / "r.jsonl"
+    assert main(["sweep", str(spec), "--out", str(out), "--dry-run"]) == 0
+    assert capsys.readouterr().out.splitlines()[2].split() == ["tiny", "collision", "car/small",
+                                                               "2", "2", "12"]  # fmt: skip
+    run_sweep(load_spec(spec), out, local_executor(1), progress=False, record="none")
+    assert sorted((r.scale, r.params["scale"]) for r in read_results(out)) == [
+        ("car", "car"),
+        ("small", "small"),
+    ]
+    # A file's own sweep may sweep it too (the same rule).
+    from sim.scenario.files import load
+
+    (tmp_path / "own.toml").write_text(SCENARIO + 'scale = ["small", "car"]\n')
+    own = [(p["robot.speed"], p["scale"]) for p in load(tmp_path / "own.toml").runs()]
+    assert own[:2] == [(0.0, "small"), (0.0, "car")] and len(own) == 6
+
+
+def _results_line(**fields: object) -> str:
+    return json.dumps({"schema": 1, "code": code_version(), "sweep": "tiny", **fields}) + "\n"
+
+
+# What the results path holds, and the line a sweep refuses it with ({out}, {tmp} filled in).
+OUTPUTS = {
+    "a folder": ("folder", "--out {out}: is a folder; give a file name"),
+    "a file in the way": (
+        "in the way",
+        "--out {tmp}/plain/deeper: a file is in the way of this folder",
+    ),
+    "another sweep": (
+        _results_line(id="a/1", sweep="demo"),
+        "{out}: holds runs of another sweep ('demo' (1 run)), not of 'tiny'; a results file "
+        "holds one sweep, so give this one another --out (or --restart to set that file aside "
+        "and start over)",
+    ),
+    "other code": (
+        _results_line(id="a/1", code="0123456789ab"),
+        "{out}: holds runs of other code (1 by 0123456789ab; this code is "
+        + code_version()
+        + "), and a sweep resumes only its own code's runs; use another --out, or --restart "
+        "to set the old results aside and start over",
+    ),
+    "a newer schema": (
+        _results_line(id="a/1", schema=2),
+        "{out}:1: a result of schema 2, newer than this code's 1 (written by newer code, which "
+        "alone reads it); to redo its runs with this code, use another --out, or --restart to "
+        "set the file aside and start over",
+    ),
+    "a bad line": ("{}\n" + _results_line(id="a/1"), "{out}:1: not a result line ("),
+    "a sweep writing it": (
+        "locked",
+        "{out}: another sweep is writing to it; wait for it or use another --out",
+    ),  # fmt: skip
+}
+
+
+@pytest.mark.parametrize("case", list(OUTPUTS))
+def test_the_dry_run_refuses_what_the_run_refuses_with_the_same_line(
+    spec_path: Path,
+    tmp_path: Path,
+    capsys: pytest.CaptureFixture[str],
+    monkeypatch: pytest.MonkeyPatch,
+    case: str,
+) -> None:
+    import sim.runs.executors
+
+    def no_runs(*args: object, **kwargs: object) -> None:
+        raise AssertionError("a run started before the output was checked")
+
+    monkeypatch.setattr(sim.runs.executors, "local_executor", lambda *a, **k: no_runs)
+    holds, expected = OUTPUTS[case]
+    out = tmp_path / "r.jsonl"
+    writer = None
+    if holds == "folder":
+        out.mkdir()
+    elif holds == "in the way":
+        (tmp_path / "plain").write_text("x")
+        out = tmp_path / "plain" / "deeper" / "r.jsonl"
+    elif holds == "locked":
+        writer = ResultsWriter(out)  # another sweep appending to it
+    else:
+        out.write_text(holds)
+    before = sorted(p.name for p in tmp_path.iterdir())
+    lines = []
+    try:
+        for dry in (["--dry-run"], []):
+            assert main(["sweep", str(spec_path), "--out", str(out), *dry]) == 2
+            err = capsys.readouterr().err.strip()
+            assert "\n" not in err, err
+            lines.append(err)
+    finally:
+        if writer is not None:
+            writer.close()
+    assert lines[0] == lines[1]
+    expected = "monopic sweep: error: " + expected.format(out=out, tmp=tmp_path)
+    assert lines[0].startswith(expected), lines[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == before  # neither wrote anything
+
+
+def test_a_dry_run_with_restart_says_what_it_would_set_aside(
+    spec_path: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    out = tmp_path / "r.jsonl"
+    out.write_text(_results_line(id="a/1", sweep="demo"))
+    assert main(["sweep", str(spec_path), "--out", str(out), "--dry-run", "--restart"]) == 0
+    printed = capsys.readouterr().out.splitlines()
+    assert printed[0] == f"would set aside (--restart): {out} -> {tmp_path / 'r.demo.jsonl'}"
+    assert printed[1] == f"{spec_path}: 3 runs in 1 families, 0 already in {out}, 3 to run"
+    (tmp_path / "r.demo.jsonl").write_text("")  # an earlier one is never overwritten
+    for dry in (["--dry-run"], []):
+        assert main(["sweep", str(spec_path), "--out", str(out), "--restart", *dry]) == 2
+        assert capsys.readouterr().err.strip() == (
+            f"monopic sweep: error: {tmp_path / 'r.demo.jsonl'}: already there; move it away "
+            f"to restart {out}"
+        )
+    assert out.read_text() == _results_line(id="a/1", sweep="demo")
