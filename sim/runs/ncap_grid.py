@@ -105,6 +105,10 @@ class NcapRun:
     code: str = ""
     latency: LatencySetting = LatencySetting(MEASURED, None)
 
+    def __post_init__(self) -> None:
+        if self.latency.ms != self.aeb.latency_ms:  # the row must say what the run applied
+            raise ValueError(f"latency {self.latency} but AEB {self.aeb}")
+
 
 def aeb_params(car: CarSpec, latency: LatencySetting) -> AebParams:
     return AebParams(car.brake_delay, car.jerk, car.deceleration, latency.ms)
