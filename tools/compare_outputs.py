@@ -1,8 +1,9 @@
 """Before/after check for restructurings: the same commands give the same outputs.
 
-    python tools/compare_outputs.py capture DIR     # run the four commands, outputs in DIR
+    python tools/compare_outputs.py capture DIR     # run the five commands, outputs in DIR
     python tools/compare_outputs.py compare OLD NEW  # field by field; exit 1 on a difference
     python tools/compare_outputs.py compare OLD NEW --renamed sim.cases=sim.scenario.cases
+    python tools/compare_outputs.py compare-ncap A B  # two `monopic ncap` output folders
 
 `capture` runs, with the installed `monopic` command (so it works on any layout):
 
@@ -10,13 +11,18 @@
 - `monopic dataset scenarios/datasets/cases-heldout.toml`;
 - `monopic closed-loop` on two small-robot families (a collision and a near miss) at a
   fixed latency (the measured one is a timing, not a result);
-- `monopic record 5`.
+- `monopic record 5`;
+- `monopic ncap --quick` with the car file's declared latency (the Euro NCAP rating).
 
 `compare` matches sweep runs by their scenario parameters (file, params, seed), not by
 line order, and leaves out what is allowed to differ: the code digest, measured times
 (`timing`, `*Ms` columns, "ms"/"seconds" figures) and the machine. Dataset images and
 masks are compared by their decoded pixels, recordings by every component row that
-rerun's own reader gives back (recording ids and wall-clock times excluded).
+rerun's own reader gives back (recording ids and wall-clock times excluded). Euro NCAP
+runs are matched by run id, each row without its measured times and measured per-frame
+latencies (with a declared latency nothing else depends on the host), and the score
+table of its report.md line by line. `compare-ncap` compares two `monopic ncap` output
+folders that way, e.g. the same command run twice, once under load.
 """
 
 from __future__ import annotations
@@ -53,6 +59,10 @@ VOLATILE_KEYS = {
     "created",
     "date",
     "bytes",
+    # A closed-loop or Euro NCAP run's measured pipeline latencies (applied only when a
+    # run asked for the measured latency; `latency` says which was applied, and is kept).
+    "latencies_ms",
+    "latency_ms_median",
 }
 
 
@@ -93,6 +103,7 @@ def capture(out: Path) -> None:
         "--policies", "none,truth,rules/ground", "--out", str(out / "closed_loop.md"), log=log,
     )  # fmt: skip
     monopic("record", "5", "--rrd", str(out / "case5.rrd"), log=log)
+    monopic("ncap", "--quick", "--restart", "--out", str(out / "ncap"), log=log)
 
 
 # --- comparison ---------------------------------------------------------------------------
@@ -263,6 +274,61 @@ def compare_record(old: Path, new: Path) -> list[str]:
     return out
 
 
+def ncap_rows(path: Path) -> dict[str, dict[str, Any]]:
+    """A `monopic ncap` results file's rows by run id."""
+    rows = [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+    return {r["id"]: r for r in rows}
+
+
+def score_table(report: Path) -> list[str]:
+    """The table of a `monopic ncap` report's "## Points" section, one string per line."""
+    lines = report.read_text().splitlines()
+    try:
+        start = lines.index("## Points (the calculator's compute-score)")
+    except ValueError:
+        return []
+    table: list[str] = []
+    for line in lines[start + 1 :]:
+        if line.startswith("## "):
+            break
+        if line.startswith("|"):
+            table.append(line.strip())
+        elif table:
+            break
+    return table
+
+
+def compare_ncap(old: Path, new: Path, where: str = "ncap") -> list[str]:
+    """Two `monopic ncap` output folders: results row by row (by run id), the score table."""
+    out: list[str] = []
+    for folder in (old, new):
+        for name in ("results.jsonl", "report.md"):
+            if not (folder / name).is_file():
+                return [f"{where}: {folder / name} is missing"]
+    a, b = ncap_rows(old / "results.jsonl"), ncap_rows(new / "results.jsonl")
+    if set(a) != set(b):
+        only = sorted(set(a) ^ set(b))
+        out.append(f"{where}: runs differ: {len(only)} unmatched of {len(a)}/{len(b)} ({only[0]})")
+    for key in sorted(set(a) & set(b)):
+        diff(scrub(a[key]), scrub(b[key]), f"{where}[{key}]", out)
+    ta, tb = score_table(old / "report.md"), score_table(new / "report.md")
+    if not ta:
+        out.append(f"{where}: no score table in {old / 'report.md'}")
+    diff(ta, tb, f"{where}/report.md score table", out)
+    print(f"  ncap: {len(set(a) & set(b))} runs and the score table ({len(ta)} lines) compared")
+    return out
+
+
+def report(problems: list[str], what: str) -> int:
+    if problems:
+        print(f"DIFFERENT: {len(problems)} difference(s), first ones:")
+        for line in problems[:40]:
+            print(f"  {line}")
+        return 1
+    print(f"IDENTICAL: {what} match field by field")
+    return 0
+
+
 def compare(old: Path, new: Path) -> int:
     problems: list[str] = []
     problems += compare_sweep(old, new)
@@ -272,13 +338,8 @@ def compare(old: Path, new: Path) -> int:
     print("  closed loop: table compared")
     problems += closed
     problems += compare_record(old, new)
-    if problems:
-        print(f"DIFFERENT: {len(problems)} difference(s), first ones:")
-        for line in problems[:40]:
-            print(f"  {line}")
-        return 1
-    print("IDENTICAL: sweep, dataset, closed loop and recording match field by field")
-    return 0
+    problems += compare_ncap(old / "ncap", new / "ncap")
+    return report(problems, "sweep, dataset, closed loop, recording and Euro NCAP rating")
 
 
 def main() -> int:
@@ -289,6 +350,9 @@ def main() -> int:
     p.add_argument("old", type=Path)
     p.add_argument("new", type=Path)
     p.add_argument("--renamed", action="append", default=[], metavar="OLD=NEW")
+    p = sub.add_parser("compare-ncap", help="two `monopic ncap` output folders")
+    p.add_argument("old", type=Path)
+    p.add_argument("new", type=Path)
     args = parser.parse_args()
     for pair in getattr(args, "renamed", []):
         old, _, new = pair.partition("=")
@@ -296,6 +360,8 @@ def main() -> int:
     if args.verb == "capture":
         capture(args.out)
         return 0
+    if args.verb == "compare-ncap":
+        return report(compare_ncap(args.old, args.new), "Euro NCAP runs and score table")
     return compare(args.old, args.new)
 
 

@@ -22,8 +22,8 @@ import numpy as np
 
 from monopic.output import atomic_path
 from sim.analysis.ncap_score import CalculatorScore, Cell, band_colour, percent
-from sim.runs.ncap_grid import GRID, NEAR_MISS, VERIFY
-from sim.scenario.ncap import Protocol
+from sim.runs.ncap_grid import DECLARED, GRID, MEASURED, NEAR_MISS, VERIFY, LatencySetting
+from sim.scenario.ncap import CarSpec, Protocol
 
 COLOURS = {  # the calculator's own RGB (common.PREDICTION_COLOR_MAP)
     "Green": (0 / 255, 153 / 255, 51 / 255),
@@ -153,6 +153,47 @@ def near_misses(rows: Sequence[dict[str, Any]]) -> list[NearMissSummary]:
     ]
 
 
+@dataclass(frozen=True)
+class MeasuredLatency:
+    """The pipeline's per-frame latencies the runs measured (whatever latency they applied)."""
+
+    runs: int
+    frames: int
+    p50_ms: float
+    p95_ms: float
+
+
+def measured_latency(rows: Sequence[dict[str, Any]]) -> MeasuredLatency | None:
+    """p50 and p95 over every processed frame of `rows` (None: no frame measured)."""
+    values = [v for r in rows for v in r["outcome"].get("latencies_ms", ())]
+    if not values:
+        return None
+    p50, p95 = np.percentile(values, [50, 95])
+    return MeasuredLatency(len(rows), len(values), float(p50), float(p95))
+
+
+def latency_line(latency: LatencySetting, car: CarSpec, rows: Sequence[dict[str, Any]]) -> str:
+    """The latency applied and, beside it, the one the host measured during the runs."""
+    if latency.source == DECLARED:
+        applied = f"declared {latency.ms:g} ms ({car.path} latency_ms)"
+    elif latency.source == MEASURED:
+        applied = "the measured one, per frame"
+    else:
+        applied = f"fixed {latency.ms:g} ms (--latency-ms)"
+    if latency.source != DECLARED:
+        applied += (
+            "; the car file declares none"
+            if car.latency_ms is None
+            else f"; the car file declares {car.latency_ms:g} ms"
+        )
+    m = measured_latency(rows)
+    measured = "no frame measured"
+    if m is not None:
+        measured = f"p50 {m.p50_ms:.1f} ms, p95 {m.p95_ms:.1f} ms over {m.frames} frames"
+        measured += f" of {m.runs} runs"
+    return f"Latency applied: {applied}. Pipeline latency measured during the runs: {measured}."
+
+
 def plot_matrices(
     protocol: Protocol, points: Sequence[PointSummary], policy: str, tests: list[str], out: Path
 ) -> None:
@@ -268,6 +309,7 @@ def render(
     version: str,
     left_unscored: str,
     out: Path,
+    latency: LatencySetting,
 ) -> str:
     """DIR/report.md: the calculator's points first, then how they came about."""
     grid_runs = sum(r["role"] == GRID for r in rows)
@@ -287,6 +329,8 @@ def render(
         f"near-miss runs. Machine: {machine}. Wall time of this command {wall_s / 60:.1f} min "
         f"({ran_now} runs now, the rest resumed); run time summed over all runs "
         f"{run_wall / 60:.1f} min.",
+        "",
+        latency_line(latency, car, rows),
         "",
         f"Scored by the official rating calculator euroncap-rating-2026 {version} "
         "(`crash_avoidance generate-template`, `preprocess`, `compute-score`; files in "
@@ -351,12 +395,12 @@ def render(
         f"{tol.vut_speed_kmh[1]:g} km/h, car path +-{tol.vut_lateral:g} m, target speed "
         f"+-{tol.target_speed_kmh:g} km/h, target path +-{tol.target_lateral:g} m, impact point "
         f"+-{tol.impact_point:g} m.",
-        f"- AEB: brakes on the first warning after the pipeline's "
-        f"{'measured latency' if car.latency_ms is None else f'fixed {car.latency_ms:g} ms'} "
-        f"plus {car.brake_delay:g} s, building up at {car.jerk:g} m/s^3 to {car.deceleration:g} "
-        f"m/s^2; FCW = that warning. Body pitch {car.pitch.gain:g} deg per m/s^2 at "
-        f"{car.pitch.frequency:g} Hz, damping {car.pitch.damping:g} (the camera and the truth "
-        "dip; the pipeline keeps its nominal camera).",
+        f"- AEB: brakes on the first warning after the pipeline's latency "
+        f"({latency.describe()}) plus {car.brake_delay:g} s, building up at {car.jerk:g} "
+        f"m/s^3 to {car.deceleration:g} m/s^2; FCW = that warning. Body pitch "
+        f"{car.pitch.gain:g} deg per m/s^2 at {car.pitch.frequency:g} Hz, damping "
+        f"{car.pitch.damping:g} (the camera and the truth dip; the pipeline keeps its nominal "
+        "camera).",
         "- Prediction per grid point: the calculator's colour band of the worst grid run; "
         "verification value: the verification run. Cells not run: Red (no claim).",
         f"- Sources of every figure: `{protocol.path}` and `{car.path}` (comments).",

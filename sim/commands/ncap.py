@@ -7,6 +7,7 @@ import shutil
 import time
 from pathlib import Path
 
+from monopic.cli.args import non_negative_float
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
 
@@ -27,7 +28,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="Euro NCAP 2026 pedestrian tests at car scale, scored by the official calculator",
         description="Run the Euro NCAP 2026 pedestrian frontal-collision grid (CPNA, CPFA, "
         "CPNCO, CPLA; day) at car scale in closed loop: the car brakes on the pipeline's "
-        "warning after its measured latency and a brake delay, jerk-limited, its camera "
+        "warning after its latency (by default the car file's declared one, so the score "
+        "does not move with the host's load) and a brake delay, jerk-limited, its camera "
         "dipping as it brakes; every grid point is run with jittered seeds (worst and mean "
         "reported) plus an independent verification run; car-scale near misses beside. "
         "Then the official rating calculator (extra [ncap]) scores it: generate-template, "
@@ -44,6 +46,18 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--seeds", type=int, help="jittered runs per grid point (default: the car file's)"
     )
     p.add_argument("--no-near-misses", action="store_true", help="skip the near misses")
+    latency = p.add_mutually_exclusive_group()
+    latency.add_argument(
+        "--latency-ms",
+        type=non_negative_float,
+        help="apply this fixed latency instead of the car file's declared latency_ms",
+    )
+    latency.add_argument(
+        "--measured-latency",
+        action="store_true",
+        help="apply the pipeline's latency measured on this host per frame instead of the "
+        "declared one (the score then moves with the host's speed and load)",
+    )
     p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
     p.add_argument(
         "--executor",
@@ -138,9 +152,10 @@ def run(args: argparse.Namespace) -> int:
     from sim.runs import ncap_grid
     from sim.runs.executors import local_executor, ray_executor
 
+    latency = ncap_grid.latency_setting(car, args.latency_ms, args.measured_latency)
     runs = ncap_grid.expand(
         protocol, car, tests, list(policies), quick=args.quick, speeds=speeds,
-        seeds=args.seeds, near_misses=not args.no_near_misses,
+        seeds=args.seeds, near_misses=not args.no_near_misses, latency=latency,
     )  # fmt: skip
     args.out.mkdir(exist_ok=True)
     results = args.out / "results.jsonl"
@@ -193,9 +208,11 @@ def run(args: argparse.Namespace) -> int:
         version=version,
         left_unscored=LEFT_UNSCORED,
         out=args.out,
+        latency=latency,
     )
     write_text_atomically(args.out / "report.md", text)
     print(rep.score_table(scores, claimed))
+    print(rep.latency_line(latency, car, rows))
     print(f"report: {args.out / 'report.md'}")
     return 0
 
@@ -211,5 +228,9 @@ def _command(args: argparse.Namespace) -> str:
             parts.append(f"--{flag} {getattr(args, flag)}")
     if args.no_near_misses:
         parts.append("--no-near-misses")
+    if args.latency_ms is not None:
+        parts.append(f"--latency-ms {args.latency_ms:g}")
+    if args.measured_latency:
+        parts.append("--measured-latency")
     parts.append(f"--out {args.out}")
     return " ".join(parts)

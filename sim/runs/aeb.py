@@ -15,17 +15,25 @@ frame is exactly that of the continuous profile, whatever the frame rate.
 
 `run_aeb` is one closed-loop run of a scenario under a policy ("rules/ground", ...) with
 this brake, in the one run loop (sim.runs.loop) and seeded as the closed loop is.
+
+Latency: a fixed figure (what a real-time implementation guarantees; `monopic ncap`
+applies the car file's declared one by default, so that a rating is a property of the
+pipeline and not of the host's load), the pipeline's own measured one per frame, or a
+recorded sequence of per-frame latencies. The outcome keeps the measured latency of every
+processed frame, so a run made with the measured latency is replayed exactly by passing
+them back (the frames and decisions are the same: only the latency depended on the host).
 """
 
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from sim.runs.closed_loop import POLICY, LoopLog, policy_pipeline, world_seed
+from sim.runs.latency import AppliedLatency
 from sim.runs.loop import Listener, LoopFrame, OnBoard, Progress, run_loop
 from sim.scenario.spec import Scenario
 from sim.world.ground_truth import pedestrian_passed
@@ -105,8 +113,7 @@ class AebController:
     """The policy's warning on each frame, issued as FCW and turned into the brake command."""
 
     brake: JerkLimitedBrake
-    latency_ms: float | None
-    latencies: list[float] = field(default_factory=list)
+    latency: AppliedLatency
     warned_frames: int = 0
     first_warning_frame: int | None = None
     warning_ttc: float | None = None  # s to collision when the FCW was issued
@@ -116,9 +123,7 @@ class AebController:
         warned, latency = False, 0.0
         if result is not None:
             warned = bool(result.warning is not None and result.warning.collision)
-            measured = result.stage_ms["total"]
-            self.latencies.append(measured)
-            latency = (measured if self.latency_ms is None else self.latency_ms) / 1e3
+            latency = self.latency.next_ms(result.stage_ms["total"]) / 1e3
         if warned:
             self.warned_frames += 1
             if self.first_warning_frame is None:
@@ -160,7 +165,10 @@ class AebOutcome:
     final_speed: float
     max_pitch_deg: float
     warned_frames: int
-    latency_ms_median: float | None
+    latency_ms_median: float | None  # of the pipeline's measured latencies
+    # The pipeline's measured latency of every processed frame, ms (what a replay of a
+    # run made with the measured latency passes back as `latencies_ms`).
+    latencies_ms: tuple[float, ...] = field(repr=False, default=())
 
     @property
     def braked(self) -> bool:
@@ -175,11 +183,18 @@ def run_aeb(
     seed: int = 0,
     render_context: RenderContext | None = None,
     on_frame: Callable[[int], None] | None = None,
+    latencies_ms: Sequence[float] | None = None,
 ) -> AebOutcome:
-    """One closed-loop run of `scenario` with the pipeline of `policy` and this AEB."""
+    """One closed-loop run of `scenario` with the pipeline of `policy` and this AEB.
+
+    `latencies_ms`: the per-frame latencies to apply instead of the measured ones (a
+    replay: an earlier outcome's `latencies_ms`, with `params.latency_ms` None); a replay
+    that processes another number of frames raises ValueError.
+    """
+    latency = AppliedLatency(params.latency_ms, latencies_ms)
     onboard = [OnBoard(POLICY, policy_pipeline(scenario, policy))]
     brake = JerkLimitedBrake(scenario.dt, params)
-    controller = AebController(brake, params.latency_ms)
+    controller = AebController(brake, latency)
     robot, footprint = scenario.robot, scenario.pedestrian.footprint
 
     def over(step: WorldStep) -> bool:
@@ -199,6 +214,7 @@ def run_aeb(
             world, onboard, listeners, controller=controller, until=over, seed=world_seed(seed)
         )
         ped_speed = float(end.final.truth.velocity_robot[0])
+    latency.check_used()
     start = log.start_speed if log.start_speed is not None else robot.speed
     contact = log.contact_time is not None
     relative = None
@@ -207,7 +223,7 @@ def run_aeb(
     reduction = start - (log.impact_speed if contact and log.impact_speed is not None else 0.0)
     if not contact:
         reduction = start - log.final_speed if log.brake_time is not None else 0.0
-    lat = controller.latencies
+    lat = latency.measured
     return AebOutcome(
         scenario=scenario.name,
         policy=policy,
@@ -226,4 +242,5 @@ def run_aeb(
         max_pitch_deg=pitch.max_deg,
         warned_frames=controller.warned_frames,
         latency_ms_median=float(np.median(lat)) if lat else None,
+        latencies_ms=tuple(lat),
     )

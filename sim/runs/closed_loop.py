@@ -14,7 +14,8 @@ brake decision:
   robot's own state.
 
 Latency: a frame captured at step k whose processing took L seconds (the pipeline's own
-measured `stage_ms["total"]`, or a fixed figure) is known at t_k + L, and its command acts
+measured `stage_ms["total"]`, a fixed figure, or the latency recorded for that frame in an
+earlier run: sim.runs.latency) is known at t_k + L, and its command acts
 from the first frame boundary at or after that, i.e. on the step leaving frame
 k + ceil(L / dt). Commands are latched: once the brake acts the robot brakes at its
 maximum deceleration (RobotSpec.max_deceleration) until it stands, and stays standing
@@ -41,6 +42,7 @@ from monopic.pipeline import Pipeline
 from monopic.predict.base import Mode
 from monopic.predict.registry import make_predictor, predictor_names
 from sim.recording.sim_recording import SimRecording
+from sim.runs.latency import AppliedLatency
 from sim.runs.loop import Listener, LoopEnd, LoopFrame, OnBoard, Progress, run_loop
 from sim.scenario.spec import Scenario
 from sim.world.ground_truth import footprint_gap, pedestrian_passed
@@ -67,6 +69,8 @@ class LoopOutcome:
     warned_frames: int
     start_speed: float
     final_speed: float
+    # The pipeline's measured latency of every processed frame, ms (what a replay of a
+    # run made with the measured latency passes back as `latencies_ms`).
     latencies_ms: tuple[float, ...] = field(repr=False, default=())
     delays: tuple[int, ...] = field(repr=False, default=())  # frames, per warned frame
 
@@ -160,8 +164,7 @@ class BrakeController:
 
     policy: str
     brake: LatencyBrake
-    latency_ms: float | None
-    latencies: list[float] = field(default_factory=list)
+    latency: AppliedLatency
     warned_frames: int = 0
     first_warning_time: float | None = None
 
@@ -170,12 +173,11 @@ class BrakeController:
         result = frame.results.get(POLICY)
         if result is not None:
             warned = bool(result.warning is not None and result.warning.collision)
-            measured = result.stage_ms["total"]
-            self.latencies.append(measured)
-            latency = (measured if self.latency_ms is None else self.latency_ms) / 1e3
+            latency = self.latency.next_ms(result.stage_ms["total"]) / 1e3
         elif self.policy == ORACLE:
             warned = truth.collision
-            latency = 0.0 if self.latency_ms is None else self.latency_ms / 1e3
+            fixed = self.latency.latency_ms
+            latency = 0.0 if fixed is None else fixed / 1e3
         else:
             warned, latency = False, 0.0
         self.warned_frames += int(warned)
@@ -234,17 +236,22 @@ def run_closed_loop(
     latency_ms: float | None = None,
     rrd: Path | None = None,
     on_frame: Callable[[int], None] | None = None,
+    latencies_ms: Sequence[float] | None = None,
 ) -> LoopOutcome:
     """One run of `scenario` under `policy` (see the module docstring).
 
     `latency_ms` None applies the pipeline's measured latency per frame (the oracle has
-    none); a number applies that fixed latency instead. `rrd` records the run.
+    none); a number applies that fixed latency instead. `latencies_ms` replays an earlier
+    run made with the measured latency: its outcome's `latencies_ms`, one per processed
+    frame (a replay that processes another number of frames raises ValueError). `rrd`
+    records the run.
     """
+    latency = AppliedLatency(latency_ms, latencies_ms)
     onboard = []
     if policy not in (NO_BRAKE, ORACLE):
         onboard.append(OnBoard(POLICY, policy_pipeline(scenario, policy)))
     controller = BrakeController(
-        policy, LatencyBrake(scenario.dt, scenario.robot.max_deceleration), latency_ms
+        policy, LatencyBrake(scenario.dt, scenario.robot.max_deceleration), latency
     )
     robot, footprint = scenario.robot, scenario.pedestrian.footprint
 
@@ -269,6 +276,7 @@ def run_closed_loop(
                 until=over,
                 seed=world_seed(seed),
             )
+    latency.check_used()
     return LoopOutcome(
         scenario=scenario.name,
         policy=policy,
@@ -283,7 +291,7 @@ def run_closed_loop(
         warned_frames=controller.warned_frames,
         start_speed=log.start_speed if log.start_speed is not None else robot.speed,
         final_speed=log.final_speed,
-        latencies_ms=tuple(controller.latencies),
+        latencies_ms=tuple(latency.measured),
         delays=tuple(controller.brake.delays),
     )
 

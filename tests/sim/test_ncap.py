@@ -4,6 +4,10 @@ from __future__ import annotations
 
 import json
 import math
+import subprocess
+import sys
+from dataclasses import asdict, replace
+from pathlib import Path
 
 import numpy as np
 import openpyxl
@@ -11,8 +15,13 @@ import pytest
 
 from monopic.cli.main import main
 from sim.analysis import ncap_score
+from sim.analysis.ncap_report import latency_line, measured_latency
 from sim.analysis.ncap_score import Cell, band_colour, score
-from sim.runs.aeb import AebParams, JerkLimitedBrake
+from sim.runs import ncap_grid
+from sim.runs.aeb import AebParams, JerkLimitedBrake, run_aeb
+from sim.runs.executors import local_executor
+from sim.runs.latency import AppliedLatency
+from sim.runs.ncap_grid import DECLARED, FIXED, GRID, MEASURED, LatencySetting, latency_setting
 from sim.scenario.ncap import KMH, Draw, draw_for, grid, load_car, load_protocol, scenario_for
 from sim.scenario.path import pedestrian_path
 from sim.scenario.spec import BodyPitch
@@ -179,6 +188,23 @@ def test_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys, argv, expect
     assert not out.exists()
 
 
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["--latency-ms", "40", "--measured-latency"], "not allowed with argument --latency-ms"),
+        (["--latency-ms", "-5"], "--latency-ms: must be a finite number >= 0"),
+    ],
+)
+def test_latency_options_refused_in_one_line(tmp_path, capsys, argv, expected):
+    out = tmp_path / "out"
+    with pytest.raises(SystemExit) as stop:  # argparse's own refusal (monopic.cli.main)
+        main(["ncap", *argv, "--out", str(out)])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and expected in err
+    assert not out.exists()
+
+
 def test_a_missing_calculator_is_one_line(tmp_path, capsys, monkeypatch):
     monkeypatch.setattr(ncap_score, "calculator_version", lambda: None)
     out = tmp_path / "out"
@@ -198,8 +224,19 @@ def test_ncap_command_runs_scores_and_resumes(tmp_path, capsys):
     rows = [json.loads(line) for line in (out / "results.jsonl").read_text().splitlines()]
     assert len(rows) == 2 and {r["role"] for r in rows} == {"grid", "verify"}
     assert all(r["speed_kmh"] == 20 and r["impact"] == 0.5 for r in rows)
+    for row in rows:  # the declared latency applied; the measured one kept per frame
+        assert row["latency"] == {"source": DECLARED, "applied_ms": CAR.latency_ms}
+        assert 0 < len(row["outcome"]["latencies_ms"]) <= row["outcome"]["frames"]
+    printed = capsys.readouterr().out
     report = (out / "report.md").read_text()
     assert "euroncap-rating-2026 5.4.9" in report and "matrix-rules-ground.png" in report
+    measured = measured_latency(rows)
+    line = (
+        f"Latency applied: declared {CAR.latency_ms:g} ms ({CAR.path} latency_ms). Pipeline "
+        f"latency measured during the runs: p50 {measured.p50_ms:.1f} ms, p95 "
+        f"{measured.p95_ms:.1f} ms over {measured.frames} frames of 2 runs."
+    )
+    assert line in report and line in printed
     assert (out / "matrix-rules-ground.png").stat().st_size > 10_000
     assert list((out / "calculator" / "rules-ground").glob("ca_*_report.xlsx"))
     capsys.readouterr()
@@ -231,3 +268,159 @@ def test_a_results_file_of_a_newer_schema_or_being_written_is_refused_in_one_lin
     assert out.exists()
     check_results(out, restart=True)
     assert not out.exists() and (tmp_path / "results.schema99.jsonl").exists()
+
+
+# -- the latency the AEB applies -------------------------------------------------------
+
+
+def _cpna20(latency: LatencySetting | None = None, car=CAR) -> list[ncap_grid.NcapRun]:
+    """The quick grid's CPNA 20 km/h point, one jittered run and its verification run."""
+    return ncap_grid.expand(PROTOCOL, car, ["cpna"], ["rules/ground"], quick=True,
+                            speeds=[20], seeds=1, near_misses=False, latency=latency)  # fmt: skip
+
+
+def test_the_declared_latency_is_the_default_and_the_options_replace_it():
+    assert CAR.latency_ms is not None and CAR.latency_ms > 0  # car.toml declares it
+    assert latency_setting(CAR) == LatencySetting(DECLARED, CAR.latency_ms)
+    assert latency_setting(CAR, 40.0) == LatencySetting(FIXED, 40.0)
+    assert latency_setting(CAR, measured=True) == LatencySetting(MEASURED, None)
+    assert latency_setting(replace(CAR, latency_ms=None)) == LatencySetting(MEASURED, None)
+    with pytest.raises(ValueError):
+        latency_setting(CAR, 40.0, measured=True)
+    for run in _cpna20():
+        assert run.aeb.latency_ms == CAR.latency_ms and run.latency.source == DECLARED
+
+
+def test_runs_with_another_latency_or_brake_are_other_runs(tmp_path):
+    settings = [None, LatencySetting(FIXED, 40.0), LatencySetting(MEASURED, None)]
+    ids = [{r.id for r in _cpna20(s)} for s in settings]
+    assert ids[0] == {r.id for r in _cpna20()}  # stable: a results file resumes
+    assert all(len(i) == 2 for i in ids) and not (ids[0] & ids[1] or ids[0] & ids[2] or
+                                                   ids[1] & ids[2])  # fmt: skip
+    assert not ids[0] & {r.id for r in _cpna20(car=replace(CAR, brake_delay=0.2))}
+    # A results file of runs with the declared latency: a run with the measured one
+    # resumes none of them.
+    out = tmp_path / "results.jsonl"
+    given: list[list[str]] = []
+
+    def executor(specs, on_result):
+        given.append([s.id for s in specs])
+        for spec in specs:
+            on_result({"id": spec.id, "code": spec.code, "latency": spec.latency.to_json()})
+
+    ncap_grid.run_grid(_cpna20(), out, executor, progress=False)
+    again = ncap_grid.run_grid(_cpna20(), out, executor, progress=False)
+    assert again.skipped == 2 and len(given) == 1
+    measured = ncap_grid.run_grid(_cpna20(settings[2]), out, executor, progress=False)
+    assert measured.skipped == 0 and set(given[1]) == ids[2]
+    rows = ncap_grid.read_results(out, _cpna20(settings[2]))
+    assert [r["latency"]["source"] for r in rows] == [MEASURED, MEASURED]
+
+
+def test_a_replay_applies_the_recorded_latency_of_each_frame_and_checks_their_count():
+    latency = AppliedLatency(recorded=[30.0, 45.5])
+    assert latency.next_ms(12.0) == 30.0 and latency.next_ms(99.0) == 45.5
+    assert latency.measured == [12.0, 99.0]
+    latency.check_used()
+    with pytest.raises(ValueError, match="end after 2 frames"):
+        latency.next_ms(10.0)
+    short = AppliedLatency(recorded=[30.0, 45.5])
+    short.next_ms(1.0)
+    with pytest.raises(ValueError, match="cover 2 frames; this run processed 1"):
+        short.check_used()
+    fixed = AppliedLatency(latency_ms=50.0)
+    assert fixed.next_ms(12.0) == 50.0 and fixed.measured == [12.0]
+    assert AppliedLatency().next_ms(12.0) == 12.0
+    with pytest.raises(ValueError):
+        AppliedLatency(latency_ms=50.0, recorded=[1.0])
+    with pytest.raises(ValueError):
+        AppliedLatency(recorded=[math.nan])
+
+
+def _rows(latencies: list[list[float]]) -> list[dict]:
+    return [{"outcome": {"latencies_ms": v}} for v in latencies]
+
+
+def test_the_report_line_gives_the_latency_applied_and_the_measured_one_beside_it():
+    rows = _rows([[10.0, 20.0, 30.0], [40.0, 50.0]])
+    m = measured_latency(rows)
+    assert (m.runs, m.frames, m.p50_ms) == (2, 5, 30.0)
+    assert m.p95_ms == pytest.approx(48.0)
+    car = replace(CAR, latency_ms=465.0)
+    declared = latency_line(LatencySetting(DECLARED, 465.0), car, rows)
+    assert declared == (
+        f"Latency applied: declared 465 ms ({car.path} latency_ms). Pipeline latency "
+        "measured during the runs: p50 30.0 ms, p95 48.0 ms over 5 frames of 2 runs."
+    )
+    assert "applied: fixed 40 ms (--latency-ms); the car file declares 465 ms" in latency_line(
+        LatencySetting(FIXED, 40.0), car, rows
+    )
+    assert "applied: the measured one, per frame; the car file declares none" in latency_line(
+        LatencySetting(MEASURED, None), replace(car, latency_ms=None), rows
+    )
+    assert "no frame measured" in latency_line(LatencySetting(DECLARED, 465.0), car, _rows([]))
+
+
+def _host_free(outcome) -> dict:
+    return {k: v for k, v in asdict(outcome).items() if k not in ncap_grid.OUTCOME_TIMING}
+
+
+@pytest.mark.slow
+def test_an_aeb_run_replayed_with_its_recorded_latencies_is_the_same_run():
+    run = _cpna20(LatencySetting(MEASURED, None))[0]
+    first = run_aeb(run.scenario, run.policy, run.aeb, seed=run.index)
+    assert first.warning_time is not None and len(first.latencies_ms) > 0
+    row = {"latency": run.latency.to_json(), "outcome": asdict(first)}
+    recorded = ncap_grid.replay_latencies(json.loads(json.dumps(row)))  # as stored
+    assert recorded == list(first.latencies_ms)
+    again = run_aeb(run.scenario, run.policy, run.aeb, seed=run.index, latencies_ms=recorded)
+    # The same frames and decisions: down to the float, the warning was issued at the
+    # warned frame's capture time plus the latency recorded for it, not this run's.
+    assert _host_free(again) == _host_free(first)
+    with pytest.raises(ValueError, match="not the run they were recorded in"):
+        run_aeb(run.scenario, run.policy, run.aeb, seed=run.index, latencies_ms=recorded[:-1])
+
+
+@pytest.mark.slow
+def test_a_closed_loop_run_replayed_with_its_recorded_latencies_is_the_same_run():
+    from monopic.cases import Case
+    from sim.runs.closed_loop import run_closed_loop
+    from tests.sim.test_closed_loop import crossing
+
+    scenario = crossing(Case.PERPENDICULAR_RIGHT)
+    first = run_closed_loop(scenario, "rules/ground")
+    assert first.braked and first.latencies_ms and first.delays
+    recorded = json.loads(json.dumps(list(first.latencies_ms)))  # as a results file keeps them
+    again = run_closed_loop(scenario, "rules/ground", latencies_ms=recorded)
+    assert len(again.latencies_ms) == len(first.latencies_ms)
+    assert replace(again, latencies_ms=()) == replace(first, latencies_ms=())  # delays too
+    with pytest.raises(ValueError, match="not the run they were recorded in"):
+        run_closed_loop(scenario, "rules/ground", latencies_ms=recorded[: len(recorded) // 2])
+
+
+def _busy_loops(n: int) -> list[subprocess.Popen]:
+    return [subprocess.Popen([sys.executable, "-c", "while True: pass"]) for _ in range(n)]
+
+
+def _one_run(out: Path) -> dict:
+    run = [r for r in _cpna20() if r.role == GRID]
+    assert len(run) == 1
+    outcome = ncap_grid.run_grid(run, out, local_executor(1, run=ncap_grid.work), progress=False)
+    assert outcome.finished == 1 and not outcome.failed
+    (row,) = ncap_grid.read_results(out, run)
+    return row
+
+
+@pytest.mark.slow
+def test_with_the_declared_latency_a_grid_point_is_the_same_under_load(tmp_path):
+    plain = _one_run(tmp_path / "plain.jsonl")
+    load = _busy_loops(2)
+    try:
+        loaded = _one_run(tmp_path / "loaded.jsonl")
+    finally:
+        for proc in load:
+            proc.kill()
+            proc.wait()
+    assert plain["latency"] == {"source": DECLARED, "applied_ms": CAR.latency_ms}
+    assert plain["outcome"]["warning_time"] is not None  # the brake acted on a warning
+    assert ncap_grid.without_timing(loaded) == ncap_grid.without_timing(plain)
