@@ -4,9 +4,95 @@ from __future__ import annotations
 
 import argparse
 import math
+import sys
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from monopic.errors import UserError
+
+
+def ranged(
+    low: float | None = None,
+    high: float | None = None,
+    *,
+    integer: bool = False,
+    open_low: bool = False,
+) -> Callable[[str], float]:
+    """An argument type that accepts a finite number in [low, high] ((low, high] with
+    `open_low`; an integer with `integer`), refusing anything else with one line.
+
+    Its `range_text` ('>= 1', '(0, 60]') is what the option's help shows: tests/
+    test_cli_help.py checks every ranged option's help against it and tries the values
+    just inside and outside each end, so the help cannot drift from the check."""
+
+    if low is None and high is None:
+        raise ValueError("a range needs a low or a high end")
+    if low is None:
+        text = f"<= {high:g}"
+    elif high is None:
+        text = f"{'>' if open_low else '>='} {low:g}"
+    else:
+        text = f"{'(' if open_low else '['}{low:g}, {high:g}]"
+
+    def check(value_text: str) -> float:
+        try:
+            value = int(value_text) if integer else float(value_text)
+        except ValueError:
+            kind = "an integer" if integer else "a number"
+            raise argparse.ArgumentTypeError(f"expected {kind}, got {value_text!r}") from None
+        below = low is not None and (value <= low if open_low else value < low)
+        if not math.isfinite(value) or below or (high is not None and value > high):
+            raise argparse.ArgumentTypeError(f"must be {text}, got {value_text!r}")
+        return value
+
+    check.range_text = text  # type: ignore[attr-defined]
+    check.low, check.high = low, high  # type: ignore[attr-defined]
+    check.integer, check.open_low = integer, open_low  # type: ignore[attr-defined]
+    return check
+
+
+class DeprecatedAlias(argparse.Action):
+    """An option's old name, kept working: it sets the new option's value and says on
+    stderr, once per use, that the name is deprecated and which to use (CHANGELOG.md)."""
+
+    def __init__(self, option_strings: list[str], dest: str, new: str, **kwargs: Any) -> None:
+        self.new = new
+        super().__init__(option_strings, dest, **kwargs)
+
+    def __call__(
+        self,
+        parser: argparse.ArgumentParser,
+        namespace: argparse.Namespace,
+        values: Any,
+        option_string: str | None = None,
+    ) -> None:
+        print(
+            f"{parser.prog}: warning: {option_string} is deprecated, use {self.new}",
+            file=sys.stderr,
+        )
+        setattr(namespace, self.dest, True if self.nargs == 0 else values)
+
+
+def deprecated_alias(
+    parser: argparse.ArgumentParser | Any, new: argparse.Action, *old: str
+) -> None:
+    """Add `old` names for the option `new` (its destination and type), hidden from --help.
+
+    `parser` may be an argument group. The alias's default is SUPPRESS, so the new
+    option's default stands when the old name is not given."""
+    parser.add_argument(
+        *old,
+        dest=new.dest,
+        type=new.type,
+        choices=new.choices,
+        metavar=new.metavar,
+        nargs=new.nargs,
+        action=DeprecatedAlias,
+        new=new.option_strings[0],
+        default=argparse.SUPPRESS,
+        help=argparse.SUPPRESS,
+    )
 
 
 def positive_float(text: str) -> float:
@@ -27,6 +113,10 @@ def non_negative_float(text: str) -> float:
     if not (math.isfinite(value) and value >= 0):
         raise argparse.ArgumentTypeError(f"must be a finite number >= 0, got {text!r}")
     return value
+
+
+positive_float.range_text = "> 0"  # type: ignore[attr-defined]
+non_negative_float.range_text = ">= 0"  # type: ignore[attr-defined]
 
 
 def parameter_limit(text: str) -> tuple[str, float]:
@@ -51,6 +141,9 @@ def positive_int(text: str) -> int:
     if value < 1:
         raise argparse.ArgumentTypeError(f"must be >= 1, got {text!r}")
     return value
+
+
+positive_int.range_text = ">= 1"  # type: ignore[attr-defined]
 
 
 def output_folder(folder: Path, option: str) -> Path:
