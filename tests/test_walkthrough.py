@@ -61,7 +61,7 @@ def test_the_first_ten_minutes_run_as_written(tmp_path: Path) -> None:
     assert "rerun --serve-web recordings/case5.rrd" in printed["view recordings/case5.rrd"]
     assert (
         "recording: recordings/case5.rrd"
-        in printed["record 5 --duration 2 --rrd recordings/case5.rrd"]
+        in printed["record 5 --duration 2 --out recordings/case5.rrd"]
     )
     dry = printed["sweep scenarios/sweeps/first.toml --dry-run"]
     assert "2 runs in 2 families" in dry and "time: about" in dry

@@ -102,7 +102,7 @@ def capture(out: Path) -> None:
         "closed-loop", *CLOSED_LOOP_FILES, "--speeds", "1,2", "--latency-ms", "60",
         "--policies", "none,truth,rules/ground", "--out", str(out / "closed_loop.md"), log=log,
     )  # fmt: skip
-    monopic("record", "5", "--rrd", str(out / "case5.rrd"), log=log)
+    monopic("record", "5", "--out", str(out / "case5.rrd"), log=log)
     monopic("ncap", "--quick", "--restart", "--out", str(out / "ncap"), log=log)
 
 

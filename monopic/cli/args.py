@@ -18,9 +18,10 @@ def ranged(
     *,
     integer: bool = False,
     open_low: bool = False,
+    open_high: bool = False,
 ) -> Callable[[str], float]:
-    """An argument type that accepts a finite number in [low, high] ((low, high] with
-    `open_low`; an integer with `integer`), refusing anything else with one line.
+    """An argument type that accepts a finite number in [low, high] (an end excluded with
+    `open_low` / `open_high`; an integer with `integer`), refusing anything else in one line.
 
     Its `range_text` ('>= 1', '(0, 60]') is what the option's help shows: tests/
     test_cli_help.py checks every ranged option's help against it and tries the values
@@ -29,11 +30,11 @@ def ranged(
     if low is None and high is None:
         raise ValueError("a range needs a low or a high end")
     if low is None:
-        text = f"<= {high:g}"
+        text = f"{'<' if open_high else '<='} {high:g}"
     elif high is None:
         text = f"{'>' if open_low else '>='} {low:g}"
     else:
-        text = f"{'(' if open_low else '['}{low:g}, {high:g}]"
+        text = f"{'(' if open_low else '['}{low:g}, {high:g}{')' if open_high else ']'}"
 
     def check(value_text: str) -> float:
         try:
@@ -42,13 +43,15 @@ def ranged(
             kind = "an integer" if integer else "a number"
             raise argparse.ArgumentTypeError(f"expected {kind}, got {value_text!r}") from None
         below = low is not None and (value <= low if open_low else value < low)
-        if not math.isfinite(value) or below or (high is not None and value > high):
+        above = high is not None and (value >= high if open_high else value > high)
+        if not math.isfinite(value) or below or above:
             raise argparse.ArgumentTypeError(f"must be {text}, got {value_text!r}")
         return value
 
     check.range_text = text  # type: ignore[attr-defined]
     check.low, check.high = low, high  # type: ignore[attr-defined]
-    check.integer, check.open_low = integer, open_low  # type: ignore[attr-defined]
+    check.integer = integer  # type: ignore[attr-defined]
+    check.open_low, check.open_high = open_low, open_high  # type: ignore[attr-defined]
     return check
 
 

@@ -12,6 +12,7 @@ from monopic.cli.args import (
     parameter_limit,
     positive_float,
     positive_int,
+    ranged,
 )
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
@@ -66,16 +67,19 @@ def add_training_options(p: argparse.ArgumentParser) -> None:
         "--dead-zone",
         type=non_negative_float,
         default=AUTHORS_DEAD_ZONE,
-        help="dead zone of the authors' bins, degrees and px/s (default %(default)g)",
+        help="dead zone of the authors' bins, degrees and px/s (>= 0; default %(default)g)",
     )
     p.add_argument(
-        "--max-depth", type=positive_int, default=None, help="deepest split level (default: none)"
+        "--max-depth",
+        type=positive_int,
+        default=None,
+        help="deepest split level (>= 1; default: none)",
     )
     p.add_argument(
         "--min-samples",
         type=positive_int,
         default=DEFAULT_MIN_SAMPLES,
-        help="a node with fewer training rows is not split (default %(default)d)",
+        help="a node with fewer training rows is not split (>= 1; default %(default)d)",
     )
 
 
@@ -92,15 +96,15 @@ def add_leaf_options(p: argparse.ArgumentParser) -> None:
         "--shrink",
         type=non_negative_float,
         default=10.0,
-        help="velocity-gain leaves: gains pulled toward 1 by n / (n + SHRINK) (default "
-        "%(default)g rows)",
+        help="velocity-gain leaves: gains pulled toward 1 by n / (n + SHRINK) (>= 0; "
+        "default %(default)g rows)",
     )
     p.add_argument(
         "--velocity-window",
         type=positive_float,
         default=None,
         metavar="S",
-        help="velocity as the least-squares slope over the last S seconds (default: the "
+        help="velocity as the least-squares slope over the last S seconds (> 0; default: the "
         "pipeline's 4-frame estimator, as the shipped tree)",
     )
 
@@ -121,8 +125,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     p = subparsers.add_parser(
         "tree",
         help="train or inspect the ID3 decision tree",
-        description="The ID3 decision tree over the discretised (phi, vx, vy): `tree train` "
-        "fits one on logs in the authors' CSV format, `tree show` prints a tree file.",
+        description="The ID3 decision tree over the discretised (phi, vx, vy), and the "
+        "ground intent tree: `tree train` fits one (on logs in the authors' CSV format, or "
+        "on datasets with --mode ground), `tree show` prints a tree file, `tree judge` "
+        "judges the tree and the rules on logs at the real horizon, `tree sensitivity` "
+        "replays ground intent trees on datasets' recorded features per cue value.",
     )
     sub = p.add_subparsers(dest="tree_command", required=True, metavar="ACTION")
 
@@ -154,11 +161,11 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     t.add_argument(
         "--validation-share",
-        type=positive_float,
+        type=ranged(0.0, 1.0, open_low=True, open_high=True),
         default=0.25,
         metavar="F",
         help="ground mode: share of (family, seed) groups validated on, by a fixed hash "
-        "(default %(default)g)",
+        "((0, 1); default %(default)g)",
     )
     t.add_argument(
         "--validate-family",
@@ -216,7 +223,7 @@ def register(subparsers: argparse._SubParsersAction) -> None:
         default=VELOCITY_WINDOW_S,
         metavar="S",
         help="constant velocity's and the tree's velocity: least-squares slope over the "
-        "last S seconds (default %(default)g)",
+        "last S seconds (> 0; default %(default)g)",
     )
     j.add_argument("--out", type=Path, metavar="TABLE.md", help="also write the table here")
     j.set_defaults(func=_judge)
@@ -295,8 +302,6 @@ def _train_ground(args: argparse.Namespace) -> int:
                 f"{option}: image mode only (ground mode chooses its bins and depth on "
                 "the validation split)"
             )
-    if not 0 < args.validation_share < 1:
-        raise UserError(f"--validation-share {args.validation_share:g}: must be below 1")
     runs = []
     sources = []
     for folder in args.data:

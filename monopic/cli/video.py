@@ -12,7 +12,14 @@ import cv2
 from tqdm import tqdm
 
 from monopic.camera import CameraModel
-from monopic.cli.args import non_negative_float, output_file, positive_float, positive_int
+from monopic.cli.args import (
+    deprecated_alias,
+    non_negative_float,
+    output_file,
+    positive_float,
+    positive_int,
+    ranged,
+)
 from monopic.errors import UserError
 from monopic.features.extractor import GroundColumn
 from monopic.frame import EgoState
@@ -62,7 +69,10 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--rrd", type=Path, metavar="RUN.rrd", help="rerun recording to write")
     p.add_argument(
-        "--horizon", type=positive_float, default=1.0, help="seconds ahead (default %(default)g)"
+        "--horizon",
+        type=positive_float,
+        default=1.0,
+        help="seconds ahead (> 0; default %(default)g)",
     )
     p.add_argument(
         "--mode",
@@ -85,7 +95,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="tree file for --predictor tree (default: the shipped tree)",
     )
     p.add_argument(
-        "--threads", type=positive_int, default=1, help="onnxruntime threads (default %(default)d)"
+        "--threads",
+        type=positive_int,
+        default=1,
+        help="onnxruntime threads (>= 1; default %(default)d)",
     )
     p.add_argument(
         "--spin",
@@ -132,20 +145,21 @@ def register(sub: argparse._SubParsersAction) -> None:
         "feet's mean (up to session 12) (default %(default)s)",
     )
     g = p.add_argument_group("camera geometry (needed for ground mode and the projected zone)")
-    g.add_argument("--fov", type=positive_float, help="vertical field of view, degrees")
-    g.add_argument("--camera-height", type=positive_float, help="metres above the ground")
+    g.add_argument("--fov", type=positive_float, help="vertical field of view, degrees (> 0)")
+    g.add_argument("--camera-height", type=positive_float, help="metres above the ground (> 0)")
     g.add_argument(
         "--pitch",
-        type=float,
+        type=ranged(-90.0, 90.0),
         default=0.0,
-        help="degrees, positive looks down (default %(default)g)",
+        help="degrees, positive looks down ([-90, 90]; default %(default)g)",
     )
-    g.add_argument(
-        "--speed",
+    speed = g.add_argument(
+        "--robot-speed",
         type=non_negative_float,
         default=0.0,
-        help="robot speed, m/s (default %(default)g)",
+        help="the camera-carrying robot's own speed, m/s (>= 0; default %(default)g)",
     )
+    deprecated_alias(g, speed, "--speed")
     p.set_defaults(func=run)
 
 
@@ -253,4 +267,4 @@ def _ego(args: argparse.Namespace, width: int, height: int) -> EgoState | None:
     if args.fov is None or args.camera_height is None:
         raise UserError("camera geometry needs both --fov and --camera-height")
     camera = CameraModel.from_fov(width, height, args.fov, args.camera_height, args.pitch)
-    return EgoState(camera=camera, speed=args.speed)
+    return EgoState(camera=camera, speed=args.robot_speed)

@@ -41,7 +41,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="the dataset folder (made as needed; an unfinished one of the same spec resumes)",
     )
     p.add_argument(
-        "--workers", type=positive_int, help="local worker processes (default: all cores)"
+        "--workers", type=positive_int, help="local worker processes (>= 1; default: all cores)"
     )
     p.add_argument(
         "--executor",

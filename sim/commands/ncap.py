@@ -7,12 +7,14 @@ import shutil
 import time
 from pathlib import Path
 
-from monopic.cli.args import non_negative_float
+from monopic.cli.args import deprecated_alias, non_negative_float, output_folder, positive_int
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
 
 PROTOCOL = Path("scenarios/ncap/protocol.toml")
 CAR = Path("scenarios/ncap/car.toml")
+# The protocol's day tests this grid runs, by their protocol.toml names (a test checks).
+TESTS = ("cpna", "cpfa", "cpnco", "cpla")
 LEFT_UNSCORED = (
     "CPNA, CPFA, CPNCO and CPLA at night (their night matrices are filled Red: not run, "
     "no claim); CPTA (turning: needs a robot that turns and a truth that follows it); the "
@@ -38,19 +40,36 @@ def register(sub: argparse._SubParsersAction) -> None:
         f"{PROTOCOL}, {CAR}.",
     )
     p.add_argument("--out", type=Path, required=True, metavar="DIR", help="output folder")
-    p.add_argument("--tests", default="cpna,cpfa,cpnco,cpla", help="default: all four")
-    p.add_argument("--quick", action="store_true", help="the thin grid (CI and the demo)")
-    p.add_argument("--speeds", help="only these car speeds, km/h, e.g. 20,40")
-    p.add_argument("--policies", help="default: the car file's (--quick: its primary)")
     p.add_argument(
-        "--seeds", type=int, help="jittered runs per grid point (default: the car file's)"
+        "--tests",
+        default=",".join(TESTS),
+        help=f"comma-separated, of {', '.join(TESTS)} (the protocol's day tests: car-to-"
+        "pedestrian nearside adult, farside adult, nearside child obstructed, longitudinal "
+        "adult; default: all four)",
     )
+    p.add_argument("--quick", action="store_true", help="the thin grid (CI and the demo)")
+    speeds = p.add_argument(
+        "--speeds-kmh",
+        metavar="KMH",
+        help="only these car speeds, km/h, comma-separated, e.g. 20,40 (default: every "
+        "speed of the grid)",
+    )
+    deprecated_alias(p, speeds, "--speeds")
+    p.add_argument("--policies", help="default: the car file's (--quick: its primary)")
+    runs = p.add_argument(
+        "--runs-per-point",
+        type=positive_int,
+        metavar="N",
+        help="jittered runs per grid point (>= 1; default: the car file's seeds, or "
+        "quick_seeds with --quick)",
+    )
+    deprecated_alias(p, runs, "--seeds")
     p.add_argument("--no-near-misses", action="store_true", help="skip the near misses")
     latency = p.add_mutually_exclusive_group()
     latency.add_argument(
         "--latency-ms",
         type=non_negative_float,
-        help="apply this fixed latency instead of the car file's declared latency_ms",
+        help="apply this fixed latency (>= 0) instead of the car file's declared latency_ms",
     )
     latency.add_argument(
         "--measured-latency",
@@ -58,7 +77,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="apply the pipeline's latency measured on this host per frame instead of the "
         "declared one (the score then moves with the host's speed and load)",
     )
-    p.add_argument("--workers", type=int, help="local worker processes (default: one per core)")
+    p.add_argument(
+        "--workers", type=positive_int, help="local worker processes (>= 1; default: all cores)"
+    )
     p.add_argument(
         "--executor",
         choices=("local", "ray"),
@@ -88,11 +109,9 @@ def _speeds(text: str | None) -> list[float] | None:
     try:
         values = [float(v) for v in text.split(",") if v.strip()]
     except ValueError:
-        raise UserError(
-            f"--speeds: expected km/h numbers separated by commas, got {text!r}"
-        ) from None
+        values = []
     if not values:
-        raise UserError(f"--speeds: expected km/h numbers separated by commas, got {text!r}")
+        raise UserError(f"--speeds-kmh: expected km/h numbers separated by commas, got {text!r}")
     return values
 
 
@@ -113,7 +132,7 @@ def run(args: argparse.Namespace) -> int:
             )
     if not tests:
         raise UserError("--tests: name at least one test")
-    speeds = _speeds(args.speeds)
+    speeds = _speeds(args.speeds_kmh)
     if speeds is not None:
         for v in speeds:
             ranges = [protocol.tests[t].speed_range for t in tests]
@@ -123,7 +142,7 @@ def run(args: argparse.Namespace) -> int:
                     f"{t} {lo:g}-{hi:g}" for t, (lo, hi) in zip(tests, ranges, strict=True)
                 )
                 raise UserError(
-                    f"--speeds {v:g}: not a test speed of the protocol's grid ({spans} km/h "
+                    f"--speeds-kmh {v:g}: not a test speed of the protocol's grid ({spans} km/h "
                     "in 10 km/h steps)"
                 )
     default = (car.primary,) if args.quick else car.policies  # quick: the primary only
@@ -138,14 +157,8 @@ def run(args: argparse.Namespace) -> int:
         if mode not in {m.value for m in Mode} or name not in predictor_names():
             raise UserError(f"--policies: {policy!r} is not PREDICTOR/MODE "
                             f"({', '.join(predictor_names())}; image or ground)")  # fmt: skip
-    if args.seeds is not None and args.seeds < 1:
-        raise UserError(f"--seeds: at least 1, got {args.seeds}")
-    if args.workers is not None and args.workers < 1:
-        raise UserError(f"--workers: at least 1, got {args.workers}")
-    if not args.out.parent.is_dir():
-        raise UserError(f"{args.out}: its folder {args.out.parent} does not exist")
     if args.out.exists() and not args.out.is_dir():
-        raise UserError(f"{args.out}: exists and is not a folder")
+        raise UserError(f"--out {args.out}: is a file, not a folder")
 
     from sim.analysis import ncap_report as rep
     from sim.analysis.ncap_score import score
@@ -155,9 +168,9 @@ def run(args: argparse.Namespace) -> int:
     latency = ncap_grid.latency_setting(car, args.latency_ms, args.measured_latency)
     runs = ncap_grid.expand(
         protocol, car, tests, list(policies), quick=args.quick, speeds=speeds,
-        seeds=args.seeds, near_misses=not args.no_near_misses, latency=latency,
+        seeds=args.runs_per_point, near_misses=not args.no_near_misses, latency=latency,
     )  # fmt: skip
-    args.out.mkdir(exist_ok=True)
+    output_folder(args.out, "--out")
     results = args.out / "results.jsonl"
     ncap_grid.check_results(results, args.restart)
     if args.executor == "ray":
@@ -196,7 +209,7 @@ def run(args: argparse.Namespace) -> int:
         tests=tests,
         quick=args.quick,
         speeds=speeds,
-        seeds=args.seeds or (car.quick_seeds if args.quick else car.seeds),
+        seeds=args.runs_per_point or (car.quick_seeds if args.quick else car.seeds),
         rows=rows,
         points=points,
         scores=scores,
@@ -219,13 +232,13 @@ def run(args: argparse.Namespace) -> int:
 
 def _command(args: argparse.Namespace) -> str:
     parts = ["monopic ncap"]
-    if args.tests != "cpna,cpfa,cpnco,cpla":
+    if args.tests != ",".join(TESTS):
         parts.append(f"--tests {args.tests}")
     if args.quick:
         parts.append("--quick")
-    for flag in ("speeds", "policies", "seeds", "workers"):
+    for flag in ("speeds_kmh", "policies", "runs_per_point", "workers"):
         if getattr(args, flag) is not None:
-            parts.append(f"--{flag} {getattr(args, flag)}")
+            parts.append(f"--{flag.replace('_', '-')} {getattr(args, flag)}")
     if args.no_near_misses:
         parts.append("--no-near-misses")
     if args.latency_ms is not None:

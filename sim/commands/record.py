@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 from tqdm import tqdm
 
 from monopic.cases import Case
-from monopic.cli.args import output_file
+from monopic.cli.args import deprecated_alias, output_file, ranged
 from monopic.errors import UserError
 
 if TYPE_CHECKING:  # the simulator is imported when a command runs, not when the CLI starts
@@ -39,13 +39,19 @@ def register(sub: argparse._SubParsersAction) -> None:
         formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument("scenario", metavar="SCENARIO", help="a case, 'crossing' or a scenario file")
-    p.add_argument("--rrd", type=Path, help="output file (default recordings/<scenario>.rrd)")
+    out = p.add_argument(
+        "--out",
+        type=Path,
+        metavar="FILE.rrd",
+        help="the recording to write (default recordings/<scenario>.rrd)",
+    )
+    deprecated_alias(p, out, "--rrd")
     p.add_argument(
         "--topdown-every",
-        type=int,
+        type=ranged(0, integer=True),
         default=3,
         metavar="N",
-        help="log highway-env's top-down view every N frames (0: never; default 3)",
+        help="log highway-env's top-down view every N frames (>= 0; 0: never; default 3)",
     )
     p.add_argument(
         "--after-contact",
@@ -183,10 +189,8 @@ def resolve_scenario(text: str, args: argparse.Namespace) -> Scenario:
 def run(args: argparse.Namespace) -> int:
     from sim.runs.record import record_run
 
-    if args.topdown_every < 0:
-        raise UserError(f"--topdown-every: must be >= 0, got {args.topdown_every}")
     scenario = resolve_scenario(args.scenario, args)
-    path = output_file(args.rrd or DEFAULT_FOLDER / f"{scenario.name}.rrd", "--rrd")
+    path = output_file(args.out or DEFAULT_FOLDER / f"{scenario.name}.rrd", "--out")
     with tqdm(total=scenario.frames, unit="frame", desc=scenario.name) as bar:
         summary = record_run(
             scenario,

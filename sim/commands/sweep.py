@@ -34,7 +34,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--out", type=Path, help="results file to append to (default: recordings/<name>.jsonl)"
     )
     p.add_argument(
-        "--workers", type=positive_int, help="local worker processes (default: all cores)"
+        "--workers", type=positive_int, help="local worker processes (>= 1; default: all cores)"
     )
     p.add_argument(
         "--executor",
@@ -59,7 +59,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--recordings", type=Path, help="folder for the .rrd files (default: <out>_rrd/ beside it)"
     )
-    p.add_argument("--limit", type=positive_int, help="run at most this many new runs, then stop")
+    p.add_argument(
+        "--limit", type=positive_int, help="run at most this many new runs (>= 1), then stop"
+    )
     p.add_argument(
         "--restart",
         action="store_true",

@@ -258,7 +258,7 @@ def test_record_checks_a_case_as_a_scenario_file_checks_it(
     with pytest.raises(FieldError) as in_file:
         build(CASE5, with_values(tomllib.loads(text), {key: value}))
     assert reason in in_file.value.reason
-    assert main(["record", "5", option, str(value), "--rrd", str(tmp_path / "x.rrd")]) == 2
+    assert main(["record", "5", option, str(value), "--out", str(tmp_path / "x.rrd")]) == 2
     err = one_line_error(capsys)
     assert f"{option} {value:g}" in err and reason in err
     assert not (tmp_path / "x.rrd").exists()

@@ -561,7 +561,7 @@ def test_dataset_and_closed_loop_stop_within_seconds_with_their_line(
 
     out = tmp_path / "record" / "loop.rrd"
     out.parent.mkdir()
-    record = Command.start(["record", str(scenario), "--rrd", str(out)], tmp_path, "record")
+    record = Command.start(["record", str(scenario), "--out", str(out)], tmp_path, "record")
     commands.append(record)
     record.wait_for(lambda: bool(temporaries(out.parent)), "the recording started")
     seconds = record.stop(sig)

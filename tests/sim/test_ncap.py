@@ -175,8 +175,9 @@ def test_the_calculator_scores_hand_made_cases(tmp_path):
     ("argv", "expected"),
     [
         (["--tests", "cpna,cpta"], "--tests: unknown test 'cpta'"),
-        (["--speeds", "90"], "--speeds 90: not a test speed of the protocol's grid"),
-        (["--speeds", "25"], "--speeds 25: not a test speed"),
+        (["--speeds-kmh", "90"], "--speeds-kmh 90: not a test speed of the protocol's grid"),
+        (["--speeds-kmh", "25"], "--speeds-kmh 25: not a test speed"),
+        (["--speeds-kmh", "fast"], "--speeds-kmh: expected km/h numbers separated by commas"),
         (["--policies", "oracle"], "--policies: 'oracle' is not PREDICTOR/MODE"),
     ],
 )
@@ -217,7 +218,7 @@ def test_a_missing_calculator_is_one_line(tmp_path, capsys, monkeypatch):
 @pytest.mark.slow
 def test_ncap_command_runs_scores_and_resumes(tmp_path, capsys):
     out = tmp_path / "ncap"
-    argv = ["ncap", "--tests", "cpna", "--quick", "--speeds", "20", "--seeds", "1",
+    argv = ["ncap", "--tests", "cpna", "--quick", "--speeds-kmh", "20", "--runs-per-point", "1",
             "--policies", "rules/ground", "--no-near-misses", "--workers", "2",
             "--out", str(out)]  # fmt: skip
     assert main(argv) == 0
@@ -424,3 +425,21 @@ def test_with_the_declared_latency_a_grid_point_is_the_same_under_load(tmp_path)
     assert plain["latency"] == {"source": DECLARED, "applied_ms": CAR.latency_ms}
     assert plain["outcome"]["warning_time"] is not None  # the brake acted on a warning
     assert ncap_grid.without_timing(loaded) == ncap_grid.without_timing(plain)
+
+
+def test_the_tests_named_in_the_help_are_the_protocols_day_tests():
+    from sim.commands.ncap import TESTS
+
+    assert set(TESTS) == set(PROTOCOL.tests)
+
+
+def test_the_renamed_options_still_work_and_say_they_are_deprecated(tmp_path, capsys):
+    """--speeds and --seeds (before --speeds-kmh and --runs-per-point) are aliases that
+    warn; the check after them is the new option's (one line, nothing written)."""
+    out = tmp_path / "out"
+    assert main(["ncap", "--speeds", "90", "--seeds", "2", "--out", str(out)]) == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    assert lines[0] == "monopic ncap: warning: --speeds is deprecated, use --speeds-kmh"
+    assert lines[1] == "monopic ncap: warning: --seeds is deprecated, use --runs-per-point"
+    assert lines[2].startswith("monopic ncap: error: --speeds-kmh 90: not a test speed")
+    assert len(lines) == 3 and not out.exists()

@@ -439,7 +439,7 @@ def test_the_case_placement_checks_the_same_range_at_every_entry_point(tmp_path,
 
     with pytest.raises(ValueError, match=r"distance = -3.0: must be >= 0 m"):
         CasePlacement(Case.PERPENDICULAR_LEFT, distance=-3.0)
-    assert main(["record", "5", "--distance", "-3", "--rrd", str(tmp_path / "x.rrd")]) == 2
+    assert main(["record", "5", "--distance", "-3", "--out", str(tmp_path / "x.rrd")]) == 2
     assert "--distance -3: must be >= 0 m" in capsys.readouterr().err
     scenario = tmp_path / "case.toml"
     scenario.write_text('name = "c"\n[path]\nkind = "case"\ncase = 5\ndistance = -3.0\n')
