@@ -30,7 +30,6 @@ MISSING = 0
 AUTHORS_DEAD_ZONE = 15.0
 
 IMAGE_ATTRIBUTES = ("phi", "vx", "vy")
-GROUND_ATTRIBUTES = ("forward", "left")
 
 
 class Binner(Protocol):

@@ -60,7 +60,6 @@ from monopic.tree.ops import ComparisonCounter, Ops
 
 # The simulator's intent vocabulary (sim.world.intent.Intent values; a test keeps them equal).
 INTENTS = ("keep going", "stop", "turn away", "start crossing")
-HOLD_BACK_INTENTS = ("stop", "turn away")
 START_CROSSING = "start crossing"
 # m beyond the swept band where the ground warning can fire: the zone's safety margin
 # (RobotGeometry.margin, 0.2) and the pedestrian disc's radius (PEDESTRIAN_RADIUS, 0.3) of
@@ -221,9 +220,6 @@ class IntentTreeModel:
                 split_label(lab)
             if node.mean is None or len(node.mean) != 2:
                 raise ValueError(f"node correction {node.mean!r} is not a (forward, left) pair")
-
-    def with_rules(self, rules: IntentRules) -> IntentTreeModel:
-        return replace(self, rules=rules)
 
 
 def fit_intent_model(

@@ -378,10 +378,6 @@ class WarningSummary:
         return ratio(self.warned_latency, self.collision_runs)
 
     @property
-    def recall_1s_latency(self) -> float:
-        return ratio(self.warned_1s_latency, self.collision_runs)
-
-    @property
     def near_miss_warned_share(self) -> float:
         return ratio(self.near_miss_warned, self.near_miss_runs)
 

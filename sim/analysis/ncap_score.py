@@ -33,7 +33,6 @@ from typing import Any
 
 from monopic.errors import UserError
 
-CALCULATOR = "euroncap_rating_2026"
 CALCULATOR_PIN = "euroncap-rating-2026==5.4.9"
 PRED_SHEET = "FC - Ped & Cyc pred."
 ROBUST_SHEET = "FC - Ped & Cyc robust. pred."

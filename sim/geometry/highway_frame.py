@@ -45,8 +45,3 @@ def highway_to_world(position: np.ndarray, heading: float) -> Pose2D:
     """highway-env position and heading -> world pose."""
     xy, yaw = reflect(position, heading)
     return Pose2D(float(xy[0]), float(xy[1]), yaw)
-
-
-def highway_vector_to_world(vec: np.ndarray) -> np.ndarray:
-    """A highway-env planar vector (e.g. a velocity) in world axes."""
-    return reflect(vec, 0.0)[0]

@@ -15,7 +15,7 @@ import numpy as np
 from highway_env.road.road import Road
 from highway_env.vehicle.objects import RoadObject
 
-from sim.geometry.highway_frame import highway_vector_to_world, reflect, world_to_highway
+from sim.geometry.highway_frame import reflect, world_to_highway
 from sim.scenario.path import PathState, pedestrian_path
 from sim.scenario.spec import PedestrianSpec
 from sim.world.gait import Gait
@@ -93,10 +93,6 @@ class Pedestrian(RoadObject):
     def state(self) -> PathState:
         """The current path state in the world frame."""
         return self.path.state(self.time)
-
-    @property
-    def world_velocity(self) -> np.ndarray:
-        return highway_vector_to_world(self.velocity)
 
     def polygon_at(self, t: float) -> np.ndarray:
         """Footprint polygon (5, 2), highway-env frame, where the path puts it at time t.
