@@ -10,6 +10,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
+from sim.analysis.markdown import table
 from sim.analysis.metrics import LEAD_GOAL, SweepMetrics, WarningSummary, wilson
 
 COLUMNS = (
@@ -61,7 +62,6 @@ def beside_lines(
     a: SweepMetrics, b: SweepMetrics, name_a: str, name_b: str, methods: Sequence[str]
 ) -> list[str]:
     """The report's section for `a` beside `b`: per method, then per family and method."""
-    from sim.analysis.report import table  # the report's own Markdown table
 
     head = [f"{c} ({name_a} / {name_b})" if k == 0 else c for k, c in enumerate(COLUMNS)]
     return [

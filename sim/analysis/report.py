@@ -7,7 +7,6 @@ never holds a half-written report.
 
 from __future__ import annotations
 
-import math
 from collections import Counter
 from collections.abc import Sequence
 from dataclasses import dataclass
@@ -16,6 +15,8 @@ from pathlib import Path
 from monopic.cases import Case
 from monopic.output import write_text_atomically
 from sim.analysis import plots
+from sim.analysis.beside import beside_lines
+from sim.analysis.markdown import num, pct, table
 from sim.analysis.metrics import (
     ABLATION,
     FLICKER_S,
@@ -32,30 +33,10 @@ from sim.analysis.triage import Rerunning, triage_lines
 from sim.runs.result import RunResult
 
 
-def pct(value: float) -> str:
-    return "-" if math.isnan(value) else f"{100 * value:.0f} %"
-
-
-def num(value: float, digits: int = 2) -> str:
-    return "-" if math.isnan(value) else f"{value:.{digits}f}"
-
-
 def said(cases: CaseSummary) -> str:
     """'7 toward (94 %)': the case a method answers most, with its share."""
     most = cases.most_predicted
     return "-" if most is None else f"{int(most[0])} {most[0].label} ({pct(most[1])})"
-
-
-def table(header: Sequence[str], rows: Sequence[Sequence[str]]) -> list[str]:
-    """A Markdown table (which also reads well as plain text)."""
-    widths = [max(len(str(c)) for c in col) for col in zip(header, *rows, strict=True)]
-
-    def line(cells: Sequence[str]) -> str:
-        return "| " + " | ".join(str(c).ljust(w) for c, w in zip(cells, widths, strict=True)) + " |"
-
-    return [line(header), "|" + "|".join("-" * (w + 2) for w in widths) + "|"] + [
-        line(r) for r in rows
-    ]
 
 
 HEADLINE = (
@@ -462,8 +443,6 @@ def write_report(
         "",
     ]
     if beside is not None:
-        from sim.analysis.beside import beside_lines
-
         lines += beside_lines(m, beside[1], results.stem, beside[0], main_methods)
     markdown = out_dir / "report.md"
     write_text_atomically(markdown, "\n".join(lines))

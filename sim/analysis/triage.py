@@ -18,6 +18,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
+from sim.analysis.markdown import table
 from sim.analysis.metrics import LEAD_GOAL, MAIN, RunOutcome, SweepMetrics, split_method
 from sim.runs.result import RunResult
 
@@ -191,7 +192,6 @@ def triage_lines(m: SweepMetrics, rows: Sequence[RunResult], where: Rerunning) -
 
 
 def _counts_table(m: SweepMetrics, methods: Sequence[str]) -> list[str]:
-    from sim.analysis.report import table  # the report's own Markdown table (it imports this)
 
     rows = []
     for family in [*m.families, "all"]:
