@@ -142,7 +142,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         default=PipelineConfig.ground_column.value,
         help="which landmarks set the ground point's image column (its row is the feet's): "
         "the hips' midpoint, steady through the stride; the shoulders'; or the visible "
-        "feet's mean (up to session 12) (default %(default)s)",
+        "feet's mean (default %(default)s)",
     )
     g = p.add_argument_group("camera geometry (needed for ground mode and the projected zone)")
     g.add_argument("--fov", type=positive_float, help="vertical field of view, degrees (> 0)")

@@ -41,7 +41,7 @@ class GroundColumn(StrEnum):
     shoulders move with the walker's body, not its stride. Hips by default: on the intent
     sweep (192 human-walker runs) the ground track's near-miss warnings fell from 33 to 29
     of 96 and its nuisance warnings from 431 to 258 an hour at the same recall
-    (docs/intent/ground-tree.md, session 13).
+    (docs/intent/ground-tree.md).
     """
 
     FEET = "feet"

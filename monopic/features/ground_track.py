@@ -36,10 +36,10 @@ class GroundTrackConfig:
     - initial speed: walking speed is 1-2 m/s, so a new track's velocity starts at 0 with
       a 2 m/s standard deviation in each direction;
     - column noise: by default the column is as noisy as the row (isotropic pixels). With
-      the ground column taken from the hips (session 13) the column is steadier than the
-      row: its robust spread against the truth's ground point projected was 0.5 px at
-      about 45 px tall, 1.0 px at 80, 1.4 px at 125 and 2.6 px at 200 (issue 19 session
-      15, the development intent sweep), about 0.3 px plus 1 % of the apparent height.
+      the ground column taken from the hips the column is steadier than the row: its
+      robust spread against the truth's ground point projected was 0.5 px at about 45 px
+      tall, 1.0 px at 80, 1.4 px at 125 and 2.6 px at 200 on the development intent sweep
+      (docs/intent/ground-tree.md), about 0.3 px plus 1 % of the apparent height.
       Setting `column_pixel_noise` gives the column its own model, so the track believes
       motion across the line of sight sooner than motion along it.
     """

@@ -26,7 +26,8 @@ _EPS = 1e-9
 
 def _cross(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """np.cross of two 3-vectors, term for term the same floats, in 2 us against its 21
-    (its axis handling; two calls a frame in the stage after pose, issue 21)."""
+    (its axis handling), and the stage after pose calls it twice a frame
+    (`bench/post_pose.py`)."""
     x = a[1] * b[2] - a[2] * b[1]
     y = a[2] * b[0] - a[0] * b[2]
     return np.array([x, y, a[0] * b[1] - a[1] * b[0]])

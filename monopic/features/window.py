@@ -223,9 +223,8 @@ def line_slope(t: Sequence[float], y: Sequence[float]) -> float:
     Time is taken relative to the last sample first, as `derivatives_at` does. Within
     about 2e-12 (relative) of that fit's `np.linalg.lstsq` slope, which it replaces for
     `angle_rate`: right after the landmark model, `angle_rate` with the solver took
-    0.14-0.17 ms of a frame's 0.36-0.45 ms of features, and the stage after pose in
-    `bench/compare_reference.py` fell from 0.43-0.52 to 0.33-0.40 ms without it
-    (session 20). At least two distinct times.
+    0.14-0.17 ms of a frame's 0.36-0.45 ms of features (the stage after pose:
+    `bench/post_pose.py`). At least two distinct times.
     """
     n = len(t)
     last = t[-1]

@@ -148,7 +148,7 @@ def refine_from_heatmap(points: np.ndarray, heatmap: np.ndarray, size: int) -> n
 
     The reference pipeline (MediaPipe Pose) refines the regressed coordinates this way,
     and on the shipped clip it brings our shoulders closer to the truth (median 3.9 ->
-    2.8 px, BENCHMARKS.md, issue 7). As MediaPipe's
+    2.8 px, `bench/compare_reference.py`). As MediaPipe's
     mediapipe/calculators/util/refine_landmarks_from_heatmap_calculator.cc: a point
     whose heatmap cell (x / size * width truncated toward zero, as C++ int()) lies on
     the map is replaced by the sigmoid-weighted mean cell position over the 7x7 window

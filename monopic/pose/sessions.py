@@ -16,8 +16,8 @@ import onnxruntime as ort
 # The person detector: MediaPipe's (converted by `make models`), or "int8", that model
 # quantised (`make models-int8`; its stem and feature pyramid kept float): 0.65 of the
 # float pass at one thread and 0.68 at two on an AVX-512 VNNI core, the tracker's found
-# frames and landmark error the same within the paired interval (issue 21; docs/
-# benchmarks.md, session 16).
+# frames and landmark error the same within the paired interval (`bench/int8_detector.py
+# judge`; monopic/pose/models/NOTICE.md).
 DETECTOR_MODELS = {"float": "pose_detection.onnx", "int8": "pose_detection_int8.onnx"}
 DEFAULT_DETECTOR_MODEL = "float"
 # MediaPipe's three landmark models (its model_complexity 0, 1, 2), all converted by
@@ -26,7 +26,7 @@ DEFAULT_DETECTOR_MODEL = "float"
 # full-int8 is the full model quantised (`make models-int8`; int8 weights and activations,
 # its stem and regression branch kept float): 0.67 of the full model's time at one
 # thread on an AVX-512 VNNI core, 0.82 at two; its landmark error equal to the full
-# model's within the paired interval (issue 21; docs/benchmarks.md, sessions 15-16).
+# model's within the paired interval (`bench/int8_landmarks.py judge`; NOTICE.md).
 LANDMARK_MODELS = {
     "lite": "pose_landmark_lite.onnx",
     "full": "pose_landmark_full.onnx",
@@ -111,7 +111,7 @@ def model_path(name: str) -> Path:
 # "cpu": onnxruntime's own CPU kernels (MLAS), always there. "openvino": Intel's OpenVINO
 # execution provider, a plug-in library for the same onnxruntime (the optional extra
 # `.[openvino]`, package onnxruntime-ep-openvino), in float32: its CPU kernels use the
-# AVX-512 depthwise convolutions MLAS lacks (docs/benchmarks.md, issue 21). Nodes it does
+# AVX-512 depthwise convolutions MLAS lacks (docs/benchmarks.md). Nodes it does
 # not take run on the CPU provider.
 RUNTIMES = ("cpu", "openvino")
 DEFAULT_RUNTIME = "cpu"
@@ -180,8 +180,8 @@ def make_session(
     session.force_spinning_stop), so nothing spins between frames or while the other
     model runs. Waking a sleeping thread for each of a model's ~160 small operators costs
     more than the operator: on a quiet AVX-512 host spinning took each pose model 0.82-0.84
-    of its time at 2 threads, at about the same CPU time (bench/spin.py, issue 21,
-    docs/benchmarks.md session 17). Beside other work on the cores it took twice the
+    of its time at 2 threads, at about the same CPU time (`bench/spin.py`). Beside other
+    work on the cores it took twice the
     time (`bench/spin.py --busy 2`), so no session spins by default: it is for a machine
     whose cores are the pipeline's own. One thread has no pool: nothing spins.
 

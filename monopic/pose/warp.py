@@ -8,13 +8,13 @@ bytes in the colour channels, and the frame's one conversion to four channels 0.
 that; `warp` widens a three-channel image itself when given one. While it tracks, the
 tracker widens only around the landmark crop (`WideFrame`): the same crop bytes, and in
 the 2-thread benchmark worker 87 us a frame for the widening against 138 for the whole
-frame (session 21, docs/benchmarks.md).
+frame (`bench/cold_paths.py`).
 
 The landmark model's crop is warped into the same buffers frame after frame
 (`WarpBuffers`), the same bytes without a fresh allocation per frame. What that saves is
 within this host's noise: right after a model run, widening a frame, cropping it and
 making the model's float input took 0.56 and 0.64 ms in two runs, against 0.62 with fresh
-arrays (`bench/cold_paths.py`, docs/benchmarks.md session 20).
+arrays (`bench/cold_paths.py`).
 """
 
 from __future__ import annotations
@@ -126,7 +126,7 @@ def warp(
 
     Returns a contiguous (h, w, 3) copy of the result's colour channels: dropping the
     fourth channel costs 5 us, and the models' float conversion of a contiguous crop then
-    takes 40 us against 230-390 us through the strided view (session 16, one core). With
+    takes 40 us against 230-390 us through the strided view (one core, `bench/crop_warp.py`). With
     `buffers` (of this size) the result is `buffers.three`, overwritten by the next call.
     """
     if buffers is not None and buffers.three.shape[1::-1] != tuple(size):

@@ -28,9 +28,8 @@ warning's reach of the robot's swept band (path_distance less the warning zone's
 and the pedestrian disc's radius, ZONE_REACH, over the lateral speed toward the centre
 line): where constant velocity's warning could fire. A walker who does keep going is then
 warned no later than about release_s before that, whatever their speed: a hold-back can
-delay a warning, never drop it below the lead a robot needs. (Session 7's unbounded
-hold-back cost 0.25 s of lead on validation and more on the faster judged walkers;
-docs/intent/ground-tree.md.)
+delay a warning, never drop it below the lead a robot needs. (An unbounded hold-back
+cost 0.25 s of lead on validation and more on faster walkers: docs/intent/ground-tree.md.)
 
 The shares, not the majority: a stop is rare among all rows even where it is likely,
 and the warning needs to know that it is likely, not that it is the commonest outcome.

@@ -77,7 +77,7 @@ def points_in_polygon(points: np.ndarray, polygon: np.ndarray) -> np.ndarray:
 
     Plain Python floats: the zones have 4 corners and a path 16 points, and on arrays that
     small numpy's per-call overhead was most of the time (8 against 28 us for a path, 2.5
-    for one point; issue 21). The crossing test is the vectorised one's, operation for
+    for one point: `bench/post_pose.py`). The crossing test is the vectorised one's, operation for
     operation, so the answers are the same (tests/monopic/test_after_pose_exact.py).
     """
     corners = np.asarray(polygon, dtype=float).tolist()

@@ -1,9 +1,10 @@
 """Two sweeps side by side: the same families and methods, one walker setting against another.
 
-Issue 17 asks for the medium sweep with `human` walkers beside the `rail` one, issue 18 for
-cue-bearing walkers beside cue-free ones; both are two results files of the same families,
-settings and seeds. Each cell reads "this sweep / the other", from the same metrics the
-report gives each sweep alone (sim.analysis.metrics), so no figure is computed twice.
+For comparing one walker setting with another: the medium sweep with `human` walkers
+beside the `rail` one, or cue-bearing walkers beside cue-free ones; both are two results
+files of the same families, settings and seeds. Each cell reads "this sweep / the
+other", from the same metrics the report gives each sweep alone (sim.analysis.metrics),
+so no figure is computed twice.
 """
 
 from __future__ import annotations

@@ -41,7 +41,7 @@ from sim.runs.result import ABLATION, MAIN, DecisionColumns, RunResult
 
 Z95 = 1.959963984540054
 TIMELY_TTC = 1.7  # s, Euro NCAP's timely forward collision warning
-LEAD_GOAL = 1.0  # s, the issue's goal: warned at least this long before contact
+LEAD_GOAL = 1.0  # s, the warning's goal: at least this long before contact (recall@1s)
 RANGE_BINS = (0.0, 5.0, 10.0, 15.0, 20.0, 30.0, 50.0, 1e9)  # m
 HEIGHT_BINS = (0.0, 30.0, 60.0, 120.0, 240.0, 1e9)  # px
 RADII = tuple(range(0, 301, 5))  # px, for accuracy against error radius
@@ -387,7 +387,7 @@ class WarningSummary:
 
     @property
     def meets_goal(self) -> bool:
-        """The issue's goal: recall@1s lower bound >= 0.95 and <= 5 % of near misses warned."""
+        """The warning's goal: recall@1s lower bound >= 0.95, <= 5 % of near misses warned."""
         nm_ok = self.near_miss_runs == 0 or self.near_miss_warned_share <= 0.05
         return self.collision_runs > 0 and self.recall_1s_low >= 0.95 and nm_ok
 
@@ -467,7 +467,7 @@ def case_summary(rows: Sequence[RunResult], method: str) -> CaseSummary:
     return CaseSummary(method, int(confusion.sum()), int(np.trace(confusion)), confusion)
 
 
-BEFORE_CHANGE_S = 1.5  # the issue's window before each change of behaviour
+BEFORE_CHANGE_S = 1.5  # s: the window before each change of behaviour the intent is judged in
 
 
 @dataclass(frozen=True)

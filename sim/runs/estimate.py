@@ -3,20 +3,20 @@
 The per-frame cost (seconds of one worker per simulated frame, everything a run does
 included) is measured where possible: on the finished runs of the same results file or
 dataset (their own wall times on this machine, at their settings). Before any run has
-finished it comes from the `simulator` benchmark (bench/simulator.py, bench/history.jsonl,
-2026-12-01, Intel Xeon, 2 vCPUs under load 2-4): a whole run on one core took 79.5 ms
+finished it comes from the `simulator` benchmark (bench/simulator.py; its lines in
+bench/history.jsonl name the host): a whole run on one core took 79.5 ms
 per 768x432 frame with the five predictors (45.6 ms of it MuJoCo's render, the rest the
 pipeline), 101.2 ms with the ground-truth-crop ablation. The render share is scaled by
 each camera's pixels. A dataset frame (one predictor, but a segmentation render and image
 files too) measured the same as a sweep frame without the ablation (90 ms against 90-98 ms
-at 768x432 on one core, 2026-12-01), so datasets use that figure. Frames are an upper
+at 768x432 on one core), so datasets use that figure. Frames are an upper
 bound: a run ends early at first contact, so collision runs take less. Another machine,
 or a loaded one, differs: the measured figure replaces the benchmark's as soon as one run
 has finished. Starting costs a fixed time on top, which dominates tiny sweeps: a sweep
 spent 8 s before its first run began (spawning workers that import MuJoCo, onnxruntime
-and the pipeline; 2026-12-01, 2 cores under load 4-5). A dataset starts the same workers
-and merges at the end: 5 s beyond its runs' own time on one worker, 6-10 s on two (a
-3-run 384x216 dataset, 2026-12-06, 2 cores under load 3).
+and the pipeline, on 2 cores). A dataset starts the same workers and merges at the
+end: 5 s beyond its runs' own time on one worker, 6-10 s on two (a 3-run 384x216
+dataset).
 """
 
 from __future__ import annotations

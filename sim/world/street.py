@@ -28,7 +28,7 @@ GRASS_UNDER = 0.25  # m the grass reaches under the pavements' outer edges (no c
 # whose top is the ground casts no shadow anything could see (the 1 cm step from a
 # pavement down to the grass at most), and on software GL drawing those large boxes into
 # it cost 4-11 % of a frame's render (with _add_grass's change, 0.84 of the render time
-# in all: bench/render_ab.py, docs/benchmarks.md session 10).
+# in all: `bench/render_ab.py`).
 SURFACE_GROUP = 2
 
 
@@ -212,10 +212,10 @@ def _add_grass(spec: mujoco.MjSpec, road: RoadLayout, grass: str) -> None:
 
     Four boxes around the street rather than one under everything: software GL shaded
     the grass under every road and pavement pixel again in each pass (12 % of a frame's
-    render; docs/benchmarks.md, session 10). Each piece's centre sits a whole number of texture
+    render: `bench/render_ab.py`). Each piece's centre sits a whole number of texture
     periods from the street's centre line, so the grass looks exactly as one box's did.
     A box, not a plane: MuJoCo draws a plane as a dense grid of quads, which cost
-    software GL 16 ms of a 46 ms frame for the same image (BENCHMARKS.md, session 3).
+    software GL 16 ms of a 46 ms frame for the same image (`bench/simulator.py`).
     """
     extent = road.length * 1.5
     period = 2.0 / GRASS_REPEAT
