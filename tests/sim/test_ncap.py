@@ -20,7 +20,7 @@ from sim.analysis.ncap_score import Cell, band_colour, score
 from sim.runs import ncap_grid
 from sim.runs.aeb import AebParams, JerkLimitedBrake, run_aeb
 from sim.runs.executors import local_executor
-from sim.runs.latency import AppliedLatency
+from sim.runs.latency import AppliedLatency, replay_latencies
 from sim.runs.ncap_grid import DECLARED, FIXED, GRID, MEASURED, LatencySetting, latency_setting
 from sim.scenario.ncap import KMH, Draw, draw_for, grid, load_car, load_protocol, scenario_for
 from sim.scenario.path import pedestrian_path
@@ -371,7 +371,7 @@ def test_an_aeb_run_replayed_with_its_recorded_latencies_is_the_same_run():
     first = run_aeb(run.scenario, run.policy, run.aeb, seed=run.index)
     assert first.warning_time is not None and len(first.latencies_ms) > 0
     row = {"latency": run.latency.to_json(), "outcome": asdict(first)}
-    recorded = ncap_grid.replay_latencies(json.loads(json.dumps(row)))  # as stored
+    recorded = replay_latencies(json.loads(json.dumps(row)))  # as stored
     assert recorded == list(first.latencies_ms)
     again = run_aeb(run.scenario, run.policy, run.aeb, seed=run.index, latencies_ms=recorded)
     # The same frames and decisions: down to the float, the warning was issued at the
