@@ -432,7 +432,8 @@ def rerun_ncap_line(line: dict[str, Any], run: Any, asked: Asked) -> Rerun:
     if failed is not None:
         return Rerun(_ncap_comparable(line), {}, asked.out, said, failed)
     o = again["outcome"]
-    said += f": {o['frames']} frames, contact {_contact(o['contact_time'])}"
+    hit = f"contact at {3.6 * o['impact_speed']:.1f} km/h" if o["contact"] else "no contact"
+    said += f": {o['frames']} frames, {hit}"
     return Rerun(_ncap_comparable(line), _ncap_comparable(again), asked.out, said)
 
 

@@ -290,9 +290,7 @@ def test_the_runs_on_workers_give_the_in_process_tables_with_one_or_two_workers(
 
 
 @pytest.mark.slow
-def test_rerun_gives_a_closed_loop_runs_outcome_and_recording_with_its_latencies(
-    tmp_path, capsys
-):
+def test_rerun_gives_a_closed_loop_runs_outcome_and_recording_with_its_latencies(tmp_path, capsys):
     """A run made with the measured latency is made again with the latency it measured on
     each frame: a row whose host measured 200 ms per frame (its brake acts 3 frames late)
     gives its outcome again on a host that measures far less."""
