@@ -182,7 +182,10 @@ def run(args: argparse.Namespace) -> int:
     results = results_path(args)
     if args.out is not None:
         if results.resolve() == args.out.resolve():
-            raise UserError(f"--results {results}: the same file as --out; give another")
+            raise UserError(
+                f"--out {args.out}: the tables would overwrite the results file {results}; "
+                "give another --out or --results"
+            )
         output_file(args.out, "--out")
     grid.check_results(results, args.restart)
     output_file(results, "--results")

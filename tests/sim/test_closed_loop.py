@@ -111,6 +111,10 @@ def test_braking_on_the_ground_mode_warning_avoids_contacts():
             ["--cases", "5", "--results", "scenarios"],
             "--results scenarios: is a folder; give a file name",
         ),
+        (
+            ["--cases", "5", "--out", "nowhere/t.jsonl"],
+            "--out nowhere/t.jsonl: the tables would overwrite the results file nowhere/t.jsonl",
+        ),
     ],
 )
 def test_closed_loop_command_rejects_bad_input_in_one_line(capsys, monkeypatch, argv, expected):
