@@ -46,7 +46,7 @@ IGNORED = ("timing", "code", "recording")
 @dataclass(frozen=True)
 class Rerun:
     """One line's run done again: the line as stored and as it came out now (the keys
-    compared), the recording, the run in words ("case5 (robot.speed = 2): 30 frames,
+    compared), the recording, the run in words ("(case5, robot.speed = 2): 30 frames,
     contact at 1.93 s") and, if it failed when run again, its error."""
 
     stored: dict[str, Any]
