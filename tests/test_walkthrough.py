@@ -71,5 +71,5 @@ def test_the_first_ten_minutes_run_as_written(tmp_path: Path) -> None:
     assert (rec / "first_report" / "report.md").is_file()
     assert (
         "| rules/ground | 1 |"
-        in printed["closed-loop --cases 5 --speeds 2 --policies rules/ground"]
+        in printed["closed-loop --cases 5 --robot-speeds 2 --policies rules/ground"]
     )

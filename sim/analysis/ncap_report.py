@@ -22,6 +22,7 @@ import numpy as np
 
 from monopic.output import atomic_path
 from sim.analysis.ncap_score import CalculatorScore, Cell, band_colour, percent
+from sim.analysis.triage import Rerunning, ncap_triage_lines
 from sim.runs.ncap_grid import DECLARED, GRID, MEASURED, NEAR_MISS, VERIFY, LatencySetting
 from sim.scenario.ncap import CarSpec, Protocol
 
@@ -33,6 +34,7 @@ COLOURS = {  # the calculator's own RGB (common.PREDICTION_COLOR_MAP)
     "Red": (255 / 255, 51 / 255, 51 / 255),
 }
 NOT_RUN = (0.85, 0.85, 0.85)
+RESULTS = "results.jsonl"  # the grid's results file in its output folder
 
 
 def value(row: dict[str, Any]) -> float:
@@ -384,8 +386,8 @@ def render(
     ]
     for nm in near_misses(rows):
         lines.append(f"| {nm.policy} | {nm.runs} | {nm.braked} | {nm.warned} | {nm.contacts} |")
+    lines += ["", *ncap_triage_lines(rows, Rerunning(out / RESULTS, out, out))]
     lines += [
-        "",
         "## How the runs were made",
         "",
         f"- Timing: each run starts {t.impact_time:g} s before the nominal impact (T0 = TTC "

@@ -13,14 +13,14 @@ from __future__ import annotations
 import os
 import shlex
 from collections import Counter, defaultdict
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
 from sim.analysis.markdown import table
 from sim.analysis.metrics import LEAD_GOAL, MAIN, RunOutcome, SweepMetrics, split_method
-from sim.runs.result import RunResult
+from sim.runs.result import RunResult, values_said
 
 MISSED, LATE, NEAR_MISS = "missed", "late", "near miss warned"
 WHATS = (MISSED, LATE, NEAR_MISS)  # also the order of the list: the worst first
@@ -67,14 +67,6 @@ def primary(m: SweepMetrics) -> str | None:
     return next((x for x in m.methods if split_method(x)[0] == MAIN), None)
 
 
-def describe(params: dict[str, Any]) -> str:
-    """'robot.speed = 2, duration = 2' (the swept values), or 'the file's values'."""
-    if not params:
-        return "the file's values"
-    return ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
-                     for k, v in params.items())  # fmt: skip
-
-
 @dataclass(frozen=True)
 class Rerunning:
     """How the report points at a results file's runs: the results path as the user gave
@@ -119,6 +111,53 @@ def _link(text: str, target: Path, base: Path) -> str:
     return f"[{text}](<{rel}>)" if " " in rel else f"[{text}]({rel})"
 
 
+@dataclass(frozen=True)
+class Listed:
+    """One run in a list of runs to look at: its group (a family, a policy), what went
+    wrong (one of the list's kinds) and how (in words), its values in words, the command
+    that runs it again, what else went wrong in it, and its recording (the words the list
+    says about it; None: nothing, the command makes one)."""
+
+    id: str
+    group: str
+    what: str
+    how: str
+    values: str
+    command: str
+    also: tuple[str, ...] = ()
+    recording: str | None = None
+
+
+def listed_lines(
+    listed: Sequence[Listed], whats: Sequence[str], runs: Mapping[str, int]
+) -> list[str]:
+    """Per group, in name order: what went wrong of how many runs (`runs` per group), its
+    first PER_FAMILY runs as `listed` orders them (the worst first), the rest counted.
+    The sweep's report, the closed loop's tables and the Euro NCAP report all list so."""
+    lines: list[str] = []
+    groups: dict[str, list[Listed]] = defaultdict(list)
+    for item in listed:
+        groups[item.group].append(item)
+    for group, items in sorted(groups.items()):
+        count = Counter(item.what for item in items)
+        said = ", ".join(f"{count[w]} {w}" for w in whats if count[w])
+        lines += [f"**{group}**: {said} of {plural(runs.get(group, 0), 'run')}", ""]
+        for item in items[:PER_FAMILY]:
+            tail = [f"also {', '.join(item.also)}"] if item.also else []
+            tail += [item.recording] if item.recording else []
+            lines += [
+                f"- `{item.id}` ({item.values}): **{item.how}**" + "".join(f"; {t}" for t in tail),
+                f"  `{item.command}`",
+            ]
+        rest = items[PER_FAMILY:]
+        if rest:
+            count = Counter(item.what for item in rest)
+            more = ", ".join(f"{count[w]} {w}" for w in whats if count[w])
+            lines.append(f"- and {len(rest)} more ({more})")
+        lines.append("")
+    return lines
+
+
 def triage_lines(m: SweepMetrics, rows: Sequence[RunResult], where: Rerunning) -> list[str]:
     """The report's section: the primary predictor's runs that went wrong, at most
     PER_FAMILY per family, each with its parameters, recording and command; then every
@@ -147,31 +186,26 @@ def triage_lines(m: SweepMetrics, rows: Sequence[RunResult], where: Rerunning) -
     ]
     if not wrong:
         lines += [f"None: {first} missed no collision, warned none late and no near miss.", ""]
-    families: dict[str, list[RunOutcome]] = defaultdict(list)
+    listed = []
     for o in wrong:
-        families[o.family].append(o)
-    for family, outcomes in sorted(families.items()):
-        runs = sum(o.family == family for o in m.outcomes[first])
-        count = Counter(went_wrong(o) for o in outcomes)
-        said = ", ".join(f"{count[w]} {w}" for w in WHATS if count[w])
-        lines += [f"**{family}**: {said} of {plural(runs, 'run')}", ""]
-        for o in outcomes[:PER_FAMILY]:
-            row = by_id.get(o.id)  # the metrics' rows (a caller may pass none)
-            also = [f"{x} {went_wrong(others[x][o.id])}" for x in others
-                    if went_wrong(others[x][o.id])]  # fmt: skip
-            link = where.link(row) if row else None
-            lines += [
-                f"- `{o.id}` ({describe(row.params if row else {})}): **{how(o)}**"
-                + (f"; also {', '.join(also)}" if also else "")
-                + f"; recording {link or 'not kept'}",
-                f"  `{where.command(o.id, row.code if row else None)}`",
-            ]
-        rest = outcomes[PER_FAMILY:]
-        if rest:
-            count = Counter(went_wrong(o) for o in rest)
-            more = ", ".join(f"{count[w]} {w}" for w in WHATS if count[w])
-            lines.append(f"- and {len(rest)} more ({more})")
-        lines.append("")
+        row = by_id.get(o.id)  # the metrics' rows (a caller may pass none)
+        also = [f"{x} {went_wrong(others[x][o.id])}" for x in others
+                if went_wrong(others[x][o.id])]  # fmt: skip
+        link = where.link(row) if row else None
+        listed.append(
+            Listed(
+                id=o.id,
+                group=o.family,
+                what=str(went_wrong(o)),
+                how=how(o),
+                values=values_said(row.params if row else {}),
+                command=where.command(o.id, row.code if row else None),
+                also=tuple(also),
+                recording=f"recording {link or 'not kept'}",
+            )
+        )
+    runs = Counter(o.family for o in m.outcomes[first])
+    lines += listed_lines(listed, WHATS, runs)
     if any(where.needs_tree(r.code) for r in rows):
         lines += [
             "TREE: the intent tree file the sweep spec names (`intent_tree`); these runs ran "
@@ -211,3 +245,115 @@ def triage_summary(m: SweepMetrics) -> str | None:
     count = Counter(went_wrong(o) for o in m.outcomes[first])
     said = ", ".join(f"{count[w]} {w}" for w in WHATS)
     return f"runs to look at ({first}): {said}; each with its `monopic rerun` command in the report"
+
+
+# -- closed-loop and Euro NCAP runs -----------------------------------------------------
+
+
+def loop_triage_lines(
+    rows: Sequence[dict[str, Any]], where: Rerunning, recorded: bool = False
+) -> list[str]:
+    """The closed loop's runs to look at (sim.runs.closed_loop.went_wrong: a braking
+    policy's contacts and needless stops), per policy, each with its scenario, recording
+    (`recorded`: the command kept recordings) and rerun command."""
+    from sim.runs.closed_loop import CONTACT, WENT_WRONG, went_wrong
+    from sim.runs.closed_loop_grid import outcome_of, source_said
+
+    outcomes = [outcome_of(row) for row in rows]
+    wrong = [
+        (row, o, what)
+        for row, o, what in zip(rows, outcomes, went_wrong(outcomes), strict=True)
+        if what is not None
+    ]
+    wrong.sort(key=lambda w: (WENT_WRONG.index(w[2]), -(w[1].impact_speed or 0.0)))
+    lines = [
+        "## Runs to look at",
+        "",
+        "The runs where a braking policy still hit the pedestrian (contact) or braked although",
+        "the same scenario without braking ended without contact (braked without need), per",
+        f"policy, at most {PER_FAMILY} each, the worst first (contacts by impact speed), the "
+        "rest counted.",
+        "Each command runs its run again into a recording and checks that it gives the same",
+        "outcome (a run made with the measured latency is replayed with the latency it",
+        "measured on each frame); `monopic view FILE.rrd` opens a recording.",
+        "",
+    ]
+    if not wrong:
+        lines += ["None: no braking policy hit the pedestrian or braked without need.", ""]
+    listed = []
+    for row, o, what in wrong:
+        how_ = (f"contact at {o.impact_speed:.2f} m/s" if what == CONTACT and o.impact_speed
+                is not None else what)  # fmt: skip
+        if what != CONTACT and o.brake_time is not None:
+            how_ += f" (brake from {o.brake_time:.2f} s)"
+        recording = None
+        if recorded:
+            path = Path(row.get("recording") or "")
+            shown = _link(path.name, path, where.report) if path.name and path.is_file() else None
+            recording = f"recording {shown or 'not kept'}"
+        listed.append(
+            Listed(
+                id=row["id"],
+                group=row["policy"],
+                what=what,
+                how=how_,
+                values=source_said(row["source"]),
+                command=where.command(row["id"], None),
+                recording=recording,
+            )
+        )
+    lines += listed_lines(listed, WENT_WRONG, Counter(row["policy"] for row in rows))
+    return lines
+
+
+def ncap_triage_lines(rows: Sequence[dict[str, Any]], where: Rerunning) -> list[str]:
+    """The Euro NCAP grid's runs to look at: every run that hit the target (contact) and
+    every near miss the car braked on (braked without need), per policy and test, each
+    with its grid point and rerun command."""
+    from sim.runs.closed_loop import CONTACT, NEEDLESS, WENT_WRONG
+    from sim.runs.ncap_grid import NEAR_MISS, run_said
+
+    wrong = []
+    for row in rows:
+        o = row["outcome"]
+        if o["contact"]:
+            wrong.append((row, CONTACT, -(o["relative_impact_speed"] or 0.0)))
+        elif row["role"] == NEAR_MISS and o["brake_time"] is not None:
+            wrong.append((row, NEEDLESS, o["brake_time"]))
+    wrong.sort(key=lambda w: (WENT_WRONG.index(w[1]), w[2]))
+    lines = [
+        "## Runs to look at",
+        "",
+        "The runs that hit the target (contact) and the car-scale near misses the car braked",
+        f"on (braked without need), per policy and test, at most {PER_FAMILY} each, the worst "
+        "first (contacts",
+        "by relative impact speed), the rest counted. Each command runs its run again from the",
+        "protocol and car files into a recording and checks that it gives the same outcome",
+        "(run it from the folder the grid ran in: the rows name the files as the command was",
+        "given them); `monopic view FILE.rrd` opens a recording.",
+        "",
+    ]
+    if not wrong:
+        lines += ["None: no run hit its target and no near miss braked.", ""]
+    listed = []
+    for row, what, _ in wrong:
+        o = row["outcome"]
+        if what == CONTACT:
+            rel = o["relative_impact_speed"]
+            said = f"contact at {3.6 * o['impact_speed']:.1f} km/h" if o["impact_speed"] else what
+            said += f" ({3.6 * rel:.1f} km/h relative)" if rel is not None else ""
+        else:
+            said = f"{what} (brake from {o['brake_time']:.2f} s)"
+        listed.append(
+            Listed(
+                id=row["id"],
+                group=f"{row['policy']}, {row['test']}",
+                what=what,
+                how=said,
+                values=run_said(row),
+                command=where.command(row["id"], None),
+            )
+        )
+    runs = Counter(f"{row['policy']}, {row['test']}" for row in rows)
+    lines += listed_lines(listed, WENT_WRONG, runs)
+    return lines

@@ -4,12 +4,17 @@ from __future__ import annotations
 
 import argparse
 import platform
+from contextlib import AbstractContextManager, nullcontext
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
-from tqdm import tqdm
-
-from monopic.cli.args import non_negative_float, output_file, output_folder
+from monopic.cli.args import (
+    deprecated_alias,
+    output_file,
+    output_folder,
+    positive_int,
+    ranged,
+)
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
 
@@ -22,6 +27,7 @@ NCAP_FAMILIES = ("cpna25", "cpna75", "cpfa50", "cpnco50", "cpla25", "cpla50")
 DEFAULT_POLICIES = "none,truth,rules/image,rules/ground"
 MEET_TIME = 3.0  # s: --cases crossings meet the robot then unless it brakes
 CASE_SPEEDS = "1,2,3"  # m/s: --cases has no file to take a speed from
+DEFAULT_RESULTS = Path("recordings/closed-loop.jsonl")
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -33,29 +39,35 @@ def register(sub: argparse._SubParsersAction) -> None:
         "horizon) and PREDICTOR/MODE (brakes at the robot's maximum deceleration when that "
         "predictor warns; the command acts after the pipeline's measured latency, at the "
         "next frame boundary). Prints contact rate, impact speed and minimum footprint gap "
-        "per policy. Default scenarios: the small-robot Euro NCAP-style collision families "
+        "per policy, and the runs to look at (a braking policy's contacts, its needless "
+        "stops) each with the `monopic rerun` command that runs it again into a recording. "
+        "Default scenarios: the small-robot Euro NCAP-style collision families "
         f"({', '.join(NCAP_FAMILIES)} in {FAMILY_FOLDER}). A scenario file (a default family "
-        "too) runs at its own robot speed and seed unless --speeds or --seed replace them, "
-        "with the file's checks (e.g. its robot's max_speed).",
+        "too) runs at its own robot speed and seed unless --robot-speeds or --seed replace "
+        "them, with the file's checks (e.g. its robot's max_speed). The runs go to local "
+        "workers (or Ray) and one result line each to a results file: the same command "
+        "again runs only the runs it lacks.",
     )
     p.add_argument(
         "files",
         nargs="*",
         type=Path,
         metavar="SCENARIO.toml",
-        help="scenario files, each at its own robot speed or at every --speeds (default: "
-        "the families above)",
+        help="scenario files, each at its own robot speed or at every --robot-speeds "
+        "(default: the families above)",
     )
     p.add_argument(
         "--cases",
         help="instead of files: place_case crossings on a collision course, e.g. 5,6 "
         f"(they meet the robot's front at {MEET_TIME:g} s unless it brakes)",
     )
-    p.add_argument(
-        "--speeds",
-        help="robot speeds, m/s, comma-separated (default: each file's own robot.speed; "
-        f"--cases: {CASE_SPEEDS})",
+    speeds = p.add_argument(
+        "--robot-speeds",
+        metavar="M/S,...",
+        help="robot speeds, m/s, comma-separated, as record's --robot-speed (default: each "
+        f"file's own robot.speed; --cases: {CASE_SPEEDS})",
     )
+    deprecated_alias(p, speeds, "--speeds")
     p.add_argument(
         "--policies",
         default=DEFAULT_POLICIES,
@@ -65,16 +77,40 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--latency-ms",
-        type=non_negative_float,
-        help="apply this fixed latency instead of the measured one",
+        type=ranged(0),
+        help="apply this fixed latency (ms, >= 0) instead of the measured one",
     )
     p.add_argument(
         "--seed",
-        type=int,
-        help="environment seed: the gait phase (default: each file's own seed; --cases: 0)",
+        type=ranged(0, integer=True),
+        help="environment seed: the gait phase, an integer >= 0 (at most 2147483647, as a "
+        "scenario file's seed; default: each file's own seed; --cases: 0)",
     )
     p.add_argument("--out", type=Path, help="write the tables (Markdown) here")
+    p.add_argument(
+        "--results",
+        type=Path,
+        metavar="FILE.jsonl",
+        help="results file, one line per finished run, resumable (default: beside --out "
+        f"as <out>.jsonl; without --out {DEFAULT_RESULTS})",
+    )
     p.add_argument("--rrd-dir", type=Path, help="record every braking run into this folder")
+    p.add_argument(
+        "--workers", type=positive_int, help="local worker processes (>= 1; default: all cores)"
+    )
+    p.add_argument(
+        "--executor",
+        choices=("local", "ray"),
+        default="local",
+        help="local worker processes, or Ray tasks (extra `ray`) (default %(default)s)",
+    )
+    p.add_argument("--address", help="Ray cluster address for --executor ray (e.g. host:6379)")
+    p.add_argument(
+        "--restart",
+        action="store_true",
+        help="if the results file holds runs made by other code, rename it to "
+        "<name>.<code>.jsonl and start over; without it such a file is an error",
+    )
     p.set_defaults(func=run)
 
 
@@ -88,50 +124,6 @@ def _numbers(text: str, option: str) -> list[float]:
     return values
 
 
-def case_scenarios(cases: str, speeds: list[float], seed: int | None = None) -> list[Scenario]:
-    """Crossings on a collision course, each placed as a small-scale scenario file with
-    path.kind = "case" would place it (sim.scenario.files.placed_case): its checks."""
-    from monopic.cases import Case
-    from sim.scenario.files import Given, placed_case
-
-    out = []
-    for text in cases.split(","):
-        try:
-            case = Case(int(text))
-        except ValueError:
-            raise UserError(f"--cases: {text!r} is not a case number 1-9") from None
-        if case.lateral == 0:
-            raise UserError(f"--cases: case {int(case)} ({case.label}) does not cross the path")
-        for v in speeds:
-            if v <= 0:
-                raise UserError("--speeds: a crossing needs a moving robot (> 0 m/s)")
-            given = [Given("--speeds", "robot.speed", v)]
-            if seed is not None:
-                given.append(Given("--seed", "seed", seed))
-            fixed = {"path.distance": v * MEET_TIME, "path.meet_time": MEET_TIME,
-                     "duration": MEET_TIME + 1.0}  # fmt: skip
-            name = f"case{int(case)}@{v:g}"
-            out.append(placed_case(case, given, fixed, name=name, where=f"case {int(case)}: "))
-    return out
-
-
-def file_scenarios(
-    files: list[Path], speeds: list[float] | None, seed: int | None
-) -> list[Scenario]:
-    """Each file at its own robot speed and seed, or at each of `speeds` and at `seed`:
-    given values go through the file's checks (ScenarioFile.with_given)."""
-    from sim.scenario.files import Given, load
-
-    out = []
-    for path in files:
-        sf = load(path)
-        seeds = [] if seed is None else [Given("--seed", "seed", seed)]
-        for v in speeds if speeds is not None else [sf.base.robot.speed]:
-            given = [Given("--speeds", "robot.speed", v)] if speeds is not None else []
-            out.append(sf.with_given(given + seeds, name=f"{sf.name}@{v:g}"))
-    return out
-
-
 def _speeds_seen(scenarios: list[Scenario]) -> str:
     """The robot speeds the scenarios start at, as the footer names them."""
     speeds = sorted({s.robot.speed for s in scenarios})
@@ -143,17 +135,27 @@ def _seeds_seen(scenarios: list[Scenario]) -> str:
     return ",".join(str(v) for v in sorted({s.seed for s in scenarios}))
 
 
-def run(args: argparse.Namespace) -> int:
-    from sim.runs.closed_loop import (
-        NO_BRAKE,
-        check_policy,
-        format_runs,
-        format_table,
-        run_closed_loop,
-        summarise,
-    )
+def results_path(args: argparse.Namespace) -> Path:
+    """--results, or beside --out (<out>.jsonl), or DEFAULT_RESULTS."""
+    if args.results is not None:
+        return args.results
+    if args.out is not None:
+        return args.out.with_suffix(".jsonl")
+    return DEFAULT_RESULTS
 
-    speeds = None if args.speeds is None else _numbers(args.speeds, "--speeds")
+
+def run(args: argparse.Namespace) -> int:
+    from sim.commands.sweep import logs_above_the_bar
+    from sim.runs import closed_loop_grid as grid
+    from sim.runs.closed_loop import NO_BRAKE, check_policy, format_runs, format_table, summarise
+    from sim.runs.executors import local_executor, ray_executor
+    from sim.runs.latency import FIXED, MEASURED, LatencySetting
+
+    if args.address and args.executor != "ray":
+        raise UserError("--address is for --executor ray")
+    if args.workers and args.executor == "ray":
+        raise UserError("--workers is for --executor local (Ray schedules by the cluster's CPUs)")
+    speeds = None if args.robot_speeds is None else _numbers(args.robot_speeds, "--robot-speeds")
     policies = [p.strip() for p in args.policies.split(",") if p.strip()]
     if not policies:
         raise UserError(f"--policies: no policy in {args.policies!r}")
@@ -167,42 +169,50 @@ def run(args: argparse.Namespace) -> int:
     if args.cases:
         if args.files:
             raise UserError("give scenario files or --cases, not both")
-        case_speeds = speeds if speeds is not None else _numbers(CASE_SPEEDS, "--speeds")
-        scenarios = case_scenarios(args.cases, case_speeds, args.seed)
+        case_speeds = speeds if speeds is not None else _numbers(CASE_SPEEDS, "--robot-speeds")
+        sources = grid.case_sources(args.cases, case_speeds, MEET_TIME, args.seed)
         source = f"place_case crossings {args.cases} meeting the robot at {MEET_TIME:g} s"
-        chosen = "--speeds" if speeds is not None else "the --cases default"
+        chosen = "--robot-speeds" if speeds is not None else "the --cases default"
     else:
         files = args.files or [FAMILY_FOLDER / f"{name}.toml" for name in NCAP_FAMILIES]
-        scenarios = file_scenarios(files, speeds, args.seed)
+        sources = grid.file_sources(files, speeds, args.seed)
         source = ", ".join(str(f) for f in files)
-        chosen = "--speeds" if speeds is not None else "each file's own"
+        chosen = "--robot-speeds" if speeds is not None else "each file's own"
+    scenarios = grid.scenarios_of(sources)
+    results = results_path(args)
     if args.out is not None:
+        if results.resolve() == args.out.resolve():
+            raise UserError(
+                f"--out {args.out}: the tables would overwrite the results file {results}; "
+                "give another --out or --results"
+            )
         output_file(args.out, "--out")
+    grid.check_results(results, args.restart)
+    output_file(results, "--results")
     if args.rrd_dir is not None:
         output_folder(args.rrd_dir, "--rrd-dir")
-    outcomes = []
-    with tqdm(total=len(scenarios) * len(policies), unit="run") as bar:
-        for scenario in scenarios:
-            for policy in policies:
-                bar.set_description(f"{scenario.name} {policy}")
-                rrd = None
-                if args.rrd_dir is not None and policy != NO_BRAKE:
-                    rrd = args.rrd_dir / f"{scenario.name}-{policy.replace('/', '-')}.rrd"
-                try:
-                    outcomes.append(
-                        run_closed_loop(
-                            scenario,
-                            policy,
-                            seed=scenario.seed,
-                            latency_ms=args.latency_ms,
-                            rrd=rrd,
-                        )
-                    )
-                except ValueError as err:
-                    raise UserError(f"policy {policy!r}: {err}") from None
-                bar.update(1)
+    latency = (
+        LatencySetting(MEASURED, None)
+        if args.latency_ms is None
+        else LatencySetting(FIXED, float(args.latency_ms))
+    )
+    runs = grid.expand(sources, scenarios, policies, latency, args.rrd_dir)
+    if args.executor == "ray":
+        executor = ray_executor(args.address, run=grid.work)
+    else:
+        executor = local_executor(args.workers, run=grid.work)
+    with logs_above_the_bar(args.executor, args.address), _temporaries_cleared(args.rrd_dir):
+        outcome = grid.run_runs(runs, results, executor)
+    if outcome.failed:
+        run_id, error = outcome.failed[0]
+        raise UserError(
+            f"{len(outcome.failed)} runs failed (first: {run_id}: "
+            f"{error.strip().splitlines()[-1]}); {results} keeps the others: run the same "
+            "command to retry them"
+        )
+    rows = grid.read_results(results, runs)
+    outcomes = [grid.outcome_of(row) for row in rows]
     cam = scenarios[0].robot.camera
-    latency = "measured per frame" if args.latency_ms is None else f"fixed {args.latency_ms:g} ms"
     if args.seed is not None:
         seeds = "--seed"
     else:
@@ -211,17 +221,38 @@ def run(args: argparse.Namespace) -> int:
         f"{len(scenarios)} scenarios ({source}; robot speeds {_speeds_seen(scenarios)} m/s: "
         f"{chosen}), seed {_seeds_seen(scenarios)} ({seeds}), {cam.width}x{cam.height} frames "
         f"at {1 / scenarios[0].dt:.0f} fps, "
-        f"horizon {scenarios[0].horizon:g} s, latency {latency}; "
+        f"horizon {scenarios[0].horizon:g} s, latency {latency.describe()}; "
         f"{platform.processor() or platform.machine()}, {platform.node()}"
     )
     table = format_table(summarise(outcomes))
     print(table)
     print(f"\nRan on: {ran_on}")
+    print(f"results: {results} ({outcome.finished} runs now, {outcome.skipped} already there)")
+    look = _runs_to_look_at(rows, results, args.out.parent if args.out else Path(), args.rrd_dir)
     if args.out is not None:
         text = (
             f"# Closed loop: braking on the warning\n\nRan on: {ran_on}\n\n{table}\n\n"
-            f"## Runs\n\n{format_runs(outcomes)}\n"
+            f"## Runs\n\n{format_runs(outcomes)}\n\n" + "\n".join(look)
         )
         write_text_atomically(args.out, text)
         print(f"tables: {args.out}")
+    else:
+        print("\n" + "\n".join(look).rstrip())
     return 0
+
+
+def _runs_to_look_at(
+    rows: list[dict[str, Any]], results: Path, report: Path, rrd_dir: Path | None
+) -> list[str]:
+    from sim.analysis.triage import Rerunning, loop_triage_lines
+
+    where = Rerunning(results, rrd_dir or results.parent, report)
+    return loop_triage_lines(rows, where, recorded=rrd_dir is not None)
+
+
+def _temporaries_cleared(folder: Path | None) -> AbstractContextManager[None]:
+    """The recordings folder cleared of stale temporaries before and after the runs (a
+    worker stopped mid-run dies without deleting the recording it was writing)."""
+    from monopic.output import stale_temporaries_cleared
+
+    return nullcontext() if folder is None else stale_temporaries_cleared(folder)

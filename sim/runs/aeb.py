@@ -28,10 +28,13 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Sequence
+from contextlib import nullcontext
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
+from sim.recording.sim_recording import SimRecording
 from sim.runs.closed_loop import POLICY, LoopLog, policy_pipeline, world_seed
 from sim.runs.latency import AppliedLatency
 from sim.runs.loop import Listener, LoopFrame, OnBoard, Progress, run_loop
@@ -184,12 +187,14 @@ def run_aeb(
     render_context: RenderContext | None = None,
     on_frame: Callable[[int], None] | None = None,
     latencies_ms: Sequence[float] | None = None,
+    rrd: Path | None = None,
 ) -> AebOutcome:
     """One closed-loop run of `scenario` with the pipeline of `policy` and this AEB.
 
     `latencies_ms`: the per-frame latencies to apply instead of the measured ones (a
     replay: an earlier outcome's `latencies_ms`, with `params.latency_ms` None); a replay
-    that processes another number of frames raises ValueError.
+    that processes another number of frames raises ValueError. `rrd` records the run (as
+    the closed loop records one: sim.runs.closed_loop.LoopLog).
     """
     latency = AppliedLatency(params.latency_ms, latencies_ms)
     onboard = [OnBoard(POLICY, policy_pipeline(scenario, policy))]
@@ -205,14 +210,16 @@ def run_aeb(
         return passed or stopped or step.index >= scenario.frames
 
     with World(scenario, render=True, render_context=render_context) as world:
-        log = LoopLog(footprint, policy)
-        pitch = PitchLog(world)
-        listeners: list[Listener] = [log, pitch]
-        if on_frame is not None:
-            listeners.append(Progress(on_frame))
-        end = run_loop(
-            world, onboard, listeners, controller=controller, until=over, seed=world_seed(seed)
-        )
+        recording = SimRecording(rrd, world) if rrd is not None else None
+        with recording if recording is not None else nullcontext():
+            log = LoopLog(footprint, policy, recording)
+            pitch = PitchLog(world)
+            listeners: list[Listener] = [log, pitch]
+            if on_frame is not None:
+                listeners.append(Progress(on_frame))
+            end = run_loop(
+                world, onboard, listeners, controller=controller, until=over, seed=world_seed(seed)
+            )
         ped_speed = float(end.final.truth.velocity_robot[0])
     latency.check_used()
     start = log.start_speed if log.start_speed is not None else robot.speed

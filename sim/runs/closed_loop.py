@@ -46,6 +46,7 @@ from sim.runs.latency import AppliedLatency
 from sim.runs.loop import Listener, LoopEnd, LoopFrame, OnBoard, Progress, run_loop
 from sim.scenario.spec import Scenario
 from sim.world.ground_truth import footprint_gap, pedestrian_passed
+from sim.world.render import RenderContext
 from sim.world.world import World, WorldStep
 
 NO_BRAKE = "none"
@@ -237,6 +238,7 @@ def run_closed_loop(
     rrd: Path | None = None,
     on_frame: Callable[[int], None] | None = None,
     latencies_ms: Sequence[float] | None = None,
+    render_context: RenderContext | None = None,
 ) -> LoopOutcome:
     """One run of `scenario` under `policy` (see the module docstring).
 
@@ -244,7 +246,7 @@ def run_closed_loop(
     none); a number applies that fixed latency instead. `latencies_ms` replays an earlier
     run made with the measured latency: its outcome's `latencies_ms`, one per processed
     frame (a replay that processes another number of frames raises ValueError). `rrd`
-    records the run.
+    records the run. `render_context`: a worker's kept GL context (sim.world.render).
     """
     latency = AppliedLatency(latency_ms, latencies_ms)
     onboard = []
@@ -261,7 +263,7 @@ def run_closed_loop(
         passed = pedestrian_passed(step.truth, robot.length, footprint)
         return passed or step.index >= scenario.frames
 
-    with World(scenario, render=True) as world:
+    with World(scenario, render=True, render_context=render_context) as world:
         recording = SimRecording(rrd, world) if rrd is not None else None
         with recording if recording is not None else nullcontext():
             log = LoopLog(footprint, policy, recording)
@@ -357,6 +359,30 @@ def summarise(outcomes: Sequence[LoopOutcome]) -> list[PolicyRow]:
             )
         )
     return rows
+
+
+CONTACT, NEEDLESS = "with contact", "braked without need"
+WENT_WRONG = (CONTACT, NEEDLESS)  # also the order of the runs to look at: the worst first
+
+
+def went_wrong(outcomes: Sequence[LoopOutcome]) -> list[str | None]:
+    """Per outcome, CONTACT or NEEDLESS for a braking policy's run that went wrong as the
+    table counts it, else None: contact although the policy brakes, or braked in a run the
+    baseline (same scenario and seed) finished without contact. The baseline's own runs
+    are the reference, never listed."""
+    baseline = {(o.scenario, o.seed): o for o in outcomes if o.policy == NO_BRAKE}
+    out: list[str | None] = []
+    for o in outcomes:
+        base = baseline.get((o.scenario, o.seed))
+        if o.policy == NO_BRAKE:
+            out.append(None)
+        elif o.contact:
+            out.append(CONTACT)
+        elif o.braked and base is not None and not base.contact:
+            out.append(NEEDLESS)
+        else:
+            out.append(None)
+    return out
 
 
 def _f(x: float | None, fmt: str = ".2f") -> str:

@@ -14,6 +14,54 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import Any
+
+DECLARED, FIXED, MEASURED = "declared", "fixed", "measured"
+
+
+@dataclass(frozen=True)
+class LatencySetting:
+    """The latency a run applies: a declared figure (the Euro NCAP car file's), a fixed
+    figure given on the command line, or the pipeline's measured one per frame (`ms` None).
+    Results rows keep it as `latency` (to_json), so a row says what its run applied."""
+
+    source: str  # DECLARED, FIXED or MEASURED
+    ms: float | None
+
+    def __post_init__(self) -> None:
+        if (self.source == MEASURED) != (self.ms is None) or self.source not in (
+            DECLARED, FIXED, MEASURED,
+        ):  # fmt: skip
+            raise ValueError(f"not a latency setting: {self.source!r} {self.ms!r}")
+
+    def describe(self) -> str:
+        """As reports say it: "declared 50 ms", "fixed 40 ms", "measured per frame"."""
+        return "measured per frame" if self.ms is None else f"{self.source} {self.ms:g} ms"
+
+    def to_json(self) -> dict[str, Any]:
+        return {"source": self.source, "applied_ms": self.ms}
+
+    @classmethod
+    def from_json(cls, data: Any) -> LatencySetting:
+        """A row's `latency` back; ValueError if it is not one."""
+        if not isinstance(data, dict) or set(data) != {"source", "applied_ms"}:
+            raise ValueError(f"not a latency setting: {data!r}")
+        ms = data["applied_ms"]
+        if ms is not None and (isinstance(ms, bool) or not isinstance(ms, int | float)):
+            raise ValueError(f"not a latency setting: {data!r}")
+        return cls(data["source"], None if ms is None else float(ms))
+
+
+def replay_latencies(row: dict[str, Any]) -> list[float] | None:
+    """What a closed-loop or AEB run needs (`latencies_ms=`) to make a row's run again exactly.
+
+    A run that applied the measured latency: its measured per-frame latencies. A run that
+    applied a declared or fixed figure: None (its setting carries the figure, and nothing
+    else of the run depended on the host).
+    """
+    if row["latency"]["source"] != MEASURED:
+        return None
+    return [float(v) for v in row["outcome"]["latencies_ms"]]
 
 
 @dataclass

@@ -22,7 +22,6 @@ declared one and a run made with the measured latency can be replayed exactly.
 from __future__ import annotations
 
 import hashlib
-import sys
 import time
 import traceback
 from collections.abc import Callable, Sequence
@@ -30,13 +29,12 @@ from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
-from monopic.errors import UserError
 from sim.runs.aeb import AebParams, run_aeb
-from sim.runs.code_version import code_version
-from sim.runs.results_file import ResultsWriter, check_unlocked, read_rows, scan
+from sim.runs.latency import DECLARED, FIXED, MEASURED, LatencySetting
+from sim.runs.results_file import check_resumable
 from sim.runs.runner import machine
-from sim.runs.sweep import run_missing, say_skipped
-from sim.scenario.files import load
+from sim.runs.sweep import SweepOutcome, rows_of, run_resumable
+from sim.scenario.files import ScenarioFile, load
 from sim.scenario.ncap import (
     KMH,
     CarSpec,
@@ -52,29 +50,6 @@ from sim.world.render import KeptRenderContext
 
 SCHEMA = 1
 GRID, VERIFY, NEAR_MISS = "grid", "verify", "near-miss"
-DECLARED, FIXED, MEASURED = "declared", "fixed", "measured"
-
-
-@dataclass(frozen=True)
-class LatencySetting:
-    """The latency the AEB applies: the car file's declared figure, a fixed figure given
-    on the command line, or the pipeline's measured one per frame (`ms` None)."""
-
-    source: str  # DECLARED, FIXED or MEASURED
-    ms: float | None
-
-    def __post_init__(self) -> None:
-        if (self.source == MEASURED) != (self.ms is None) or self.source not in (
-            DECLARED, FIXED, MEASURED,
-        ):  # fmt: skip
-            raise ValueError(f"not a latency setting: {self.source!r} {self.ms!r}")
-
-    def describe(self) -> str:
-        """As reports say it: "declared 50 ms", "fixed 40 ms", "measured per frame"."""
-        return "measured per frame" if self.ms is None else f"{self.source} {self.ms:g} ms"
-
-    def to_json(self) -> dict[str, Any]:
-        return {"source": self.source, "applied_ms": self.ms}
 
 
 def latency_setting(
@@ -93,7 +68,11 @@ def latency_setting(
 
 @dataclass(frozen=True)
 class NcapRun:
-    """One closed-loop run as a worker receives it (plain, picklable data)."""
+    """One closed-loop run as a worker receives it (plain, picklable data).
+
+    `replay`: per-frame latencies to apply instead of measuring them (`monopic rerun` of a
+    run made with the measured latency); `rrd`: a recording to write of the run ("" none).
+    """
 
     id: str
     scenario: Scenario
@@ -101,9 +80,12 @@ class NcapRun:
     aeb: AebParams
     role: str  # GRID, VERIFY or NEAR_MISS
     index: int  # draw number (near misses: seed number)
-    meta: dict[str, Any] = field(default_factory=dict)  # test, function, speed, impact, draw
+    # test, function, speed, impact, draw; the protocol and car files it was made from
+    meta: dict[str, Any] = field(default_factory=dict)
     code: str = ""
     latency: LatencySetting = LatencySetting(MEASURED, None)
+    replay: tuple[float, ...] | None = None
+    rrd: str = ""
 
     def __post_init__(self) -> None:
         if self.latency.ms != self.aeb.latency_ms:  # the row must say what the run applied
@@ -137,53 +119,77 @@ def expand(
     `latency` None: the car file's declared latency (sim.runs.ncap_grid.latency_setting).
     """
     latency = latency_setting(car) if latency is None else latency
-    aeb = aeb_params(car, latency)
     n_grid = (car.quick_seeds if quick else car.seeds) if seeds is None else seeds
     points = grid(protocol, tests, quick, speeds)
+    nm = protocol.near_misses
+    files = [load(path) for path in nm.files] if near_misses else []
     runs = []
     for policy in policies:
         for point in points:
             roles = [(GRID, k) for k in range(n_grid)]
             roles += [(VERIFY, n_grid + k) for k in range(car.verification_seeds)]
             for role, k in roles:
-                d = draw_for(protocol.tolerances, point.id, k)
-                scenario = scenario_for(protocol, car, point, d, seed=k)
-                meta = {**asdict(point), "draw": asdict(d), "load_case": _case(protocol, point)}
-                runs.append(_run(policy, point.id, role, k, scenario, aeb, meta, latency))
-        if near_misses:
-            runs.extend(_near_misses(protocol, car, policy, aeb, quick, speeds, latency))
+                runs.append(grid_run(protocol, car, policy, point, role, k, latency))
+        for sf in files:
+            for v in nm.quick_speeds_kmh if quick else nm.speeds_kmh:
+                if speeds is not None and v not in speeds:
+                    continue
+                for k in range(nm.quick_seeds if quick else nm.seeds):
+                    runs.append(near_miss_run(protocol, car, policy, sf, v, k, latency))
     return runs
 
 
-def _case(protocol: Protocol, point: GridPoint) -> str:
-    return protocol.tests[point.test].load_case
+def grid_run(
+    protocol: Protocol, car: CarSpec, policy: str, point: GridPoint, role: str, k: int,
+    latency: LatencySetting,
+) -> NcapRun:  # fmt: skip
+    """The `k`-th draw of a grid point (role GRID or VERIFY)."""
+    d = draw_for(protocol.tolerances, point.id, k)
+    scenario = scenario_for(protocol, car, point, d, seed=k)
+    meta = {**asdict(point), "draw": asdict(d), "load_case": protocol.tests[point.test].load_case}
+    return _run(protocol, car, policy, point.id, role, k, scenario, meta, latency)
 
 
-def _run(policy: str, key: str, role: str, k: int, s: Scenario, aeb: AebParams,
-         meta: dict[str, Any], latency: LatencySetting) -> NcapRun:  # fmt: skip
+def near_miss_run(
+    protocol: Protocol, car: CarSpec, policy: str, sf: ScenarioFile, speed_kmh: float, k: int,
+    latency: LatencySetting,
+) -> NcapRun:  # fmt: skip
+    """Seed `k` of a car-scale near miss at `speed_kmh`, braking as the car does."""
+    base = sf.scenario({"robot.speed": speed_kmh * KMH}, name=sf.name)
+    robot = replace(base.robot, max_deceleration=car.deceleration, pitch=car.pitch)
+    s = replace(base, robot=robot, seed=k)
+    meta = {"test": "near-miss", "family": sf.name, "speed_kmh": speed_kmh}
+    key = f"{sf.name}/{speed_kmh:g}kmh"
+    return _run(protocol, car, policy, key, NEAR_MISS, k, s, meta, latency)
+
+
+def _run(protocol: Protocol, car: CarSpec, policy: str, key: str, role: str, k: int,
+         s: Scenario, meta: dict[str, Any], latency: LatencySetting) -> NcapRun:  # fmt: skip
+    aeb = aeb_params(car, latency)
     rid = f"{policy}/{key}/{role}{k}-{run_digest(s, aeb)}"
+    # The files a rerun rebuilds the run from (sim.runs.rebuild), as the command was given them.
+    meta = {**meta, "protocol": str(protocol.path), "car": str(car.path)}
     return NcapRun(rid, replace(s, name=rid), policy, aeb, role, k, meta, latency=latency)
 
 
-def _near_misses(
-    protocol: Protocol, car: CarSpec, policy: str, aeb: AebParams, quick: bool,
-    speeds: list[float] | None, latency: LatencySetting,
-) -> list[NcapRun]:  # fmt: skip
-    nm = protocol.near_misses
-    out = []
-    for path in nm.files:
-        sf = load(path)
-        for v in nm.quick_speeds_kmh if quick else nm.speeds_kmh:
-            if speeds is not None and v not in speeds:
-                continue
-            base = sf.scenario({"robot.speed": v * KMH}, name=sf.name)
-            robot = replace(base.robot, max_deceleration=car.deceleration, pitch=car.pitch)
-            for k in range(nm.quick_seeds if quick else nm.seeds):
-                s = replace(base, robot=robot, seed=k)
-                meta = {"test": "near-miss", "family": sf.name, "speed_kmh": v}
-                key = f"{sf.name}/{v:g}kmh"
-                out.append(_run(policy, key, NEAR_MISS, k, s, aeb, meta, latency))
-    return out
+def run_of(protocol: Protocol, car: CarSpec, row: dict[str, Any]) -> NcapRun:
+    """The run a results row was made by, rebuilt from the protocol and car files: its id
+    is the row's unless the files (or the code placing the runs) changed since. KeyError,
+    TypeError or ValueError for a row that is not a grid's line."""
+    latency = LatencySetting.from_json(row["latency"])
+    policy, role, k = row["policy"], row["role"], int(row["index"])
+    if role == NEAR_MISS:
+        for path in protocol.near_misses.files:
+            sf = load(path)
+            if sf.name == row["family"]:
+                return near_miss_run(protocol, car, policy, sf, float(row["speed_kmh"]), k, latency)
+        raise ValueError(f"{protocol.path}: no near miss {row['family']!r} in near_misses.files")
+    if role not in (GRID, VERIFY):
+        raise ValueError(f"role {role!r}")
+    point = GridPoint(row["test"], row["function"], float(row["speed_kmh"]), float(row["impact"]))
+    if point.test not in protocol.tests:
+        raise ValueError(f"{protocol.path}: no test {point.test!r}")
+    return grid_run(protocol, car, policy, point, role, k, latency)
 
 
 def work(spec: NcapRun, kept: KeptRenderContext | None = None) -> dict[str, Any]:
@@ -193,7 +199,13 @@ def work(spec: NcapRun, kept: KeptRenderContext | None = None) -> dict[str, Any]
         context = kept.fitting(camera.width, camera.height) if kept is not None else None
         t0 = time.perf_counter()
         outcome = run_aeb(
-            spec.scenario, spec.policy, spec.aeb, seed=spec.index, render_context=context
+            spec.scenario,
+            spec.policy,
+            spec.aeb,
+            seed=spec.index,
+            render_context=context,
+            latencies_ms=spec.replay,
+            rrd=Path(spec.rrd) if spec.rrd else None,
         )
         return {
             "schema": SCHEMA,
@@ -212,6 +224,15 @@ def work(spec: NcapRun, kept: KeptRenderContext | None = None) -> dict[str, Any]
         return {"id": spec.id, "error": traceback.format_exc()}
 
 
+def run_said(row: dict[str, Any]) -> str:
+    """A row's run in words: 'CPNA day AEB 20 km/h, impact 50 %, grid run 0' or
+    'nearmiss_kerb_stop at 40 km/h, seed 1'."""
+    if row["role"] == NEAR_MISS:
+        return f"{row['family']} at {row['speed_kmh']:g} km/h, seed {row['index']}"
+    return (f"{row['load_case']} {row['function']} {row['speed_kmh']:g} km/h, impact "
+            f"{round(100 * row['impact']):d}%, {row['role']} run {row['index']}")  # fmt: skip
+
+
 # What a row holds that depends on the host's speed and load, not on the pipeline and the
 # settings: with a declared or fixed latency everything else of a row is the same on one
 # host at any load (tests/sim/test_ncap.py runs a grid point under an artificial load).
@@ -227,78 +248,22 @@ def without_timing(row: dict[str, Any]) -> dict[str, Any]:
     return out
 
 
-def replay_latencies(row: dict[str, Any]) -> list[float] | None:
-    """What `run_aeb(..., latencies_ms=)` needs to make a row's run again exactly.
-
-    A run that applied the measured latency: its measured per-frame latencies. A run that
-    applied a declared or fixed figure: None (its NcapRun's AebParams carry the figure,
-    and nothing else of the run depended on the host).
-    """
-    if row["latency"]["source"] != MEASURED:
-        return None
-    return [float(v) for v in row["outcome"]["latencies_ms"]]
-
-
 Executor = Callable[[Sequence[NcapRun], Callable[[dict[str, Any]], None]], None]
-
-
-@dataclass(frozen=True)
-class GridOutcome:
-    total: int
-    skipped: int
-    finished: int
-    failed: tuple[tuple[str, str], ...]
-    seconds: float
 
 
 def check_results(out: Path, restart: bool) -> None:
     """Refuse (one line) a results file of other code or of a newer schema, unless
     `restart` sets it aside, and one another grid is appending to (as a sweep does)."""
-    if not out.exists():
-        return
-    code = code_version()
-    state = scan(out)
-    other = state.other_code(code)
-    newer = state.newer_schema(SCHEMA)
-    if newer and not restart:
-        raise UserError(
-            f"{out}:{newer[0]}: a result of schema {newer[1]}, newer than this code's "
-            f"{SCHEMA} (written by newer code, which alone reads it); use another --out, or "
-            "--restart to set the file aside and start over"
-        )
-    if other and not restart:
-        raise UserError(
-            f"{out}: holds runs of other code ({', '.join(other)}; this code is {code}); "
-            "use another --out, or --restart to set them aside and start over"
-        )
-    check_unlocked(out)
-    if other or newer:
-        tag = (next(iter(other)) if len(other) == 1 else "mixed") if other else f"schema{newer[1]}"
-        target = out.with_name(f"{out.stem}.{tag}{out.suffix}")
-        if target.exists():
-            raise UserError(f"{target}: already there; move it away to restart {out}")
-        out.rename(target)
-        print(f"set aside: {out} -> {target}", file=sys.stderr)
+    check_resumable(out, SCHEMA, restart, "--out")
 
 
 def run_grid(
     runs: list[NcapRun], out: Path, executor: Executor, progress: bool = True
-) -> GridOutcome:
+) -> SweepOutcome:
     """Run every run missing from `out`, appending each result line as it finishes."""
-    code = code_version()
-    runs = [replace(r, code=code) for r in runs]
-    with ResultsWriter(out) as writer:
-        todo = [r for r in runs if r.id not in writer.state.ids]
-        skipped = len(runs) - len(todo)
-        start = time.perf_counter()
-        if skipped and progress:
-            say_skipped(out, skipped, len(runs), len(todo))
-        finished, failed = run_missing(todo, executor, writer, "ncap", progress)
-    return GridOutcome(len(runs), skipped, finished, tuple(failed), time.perf_counter() - start)
+    return run_resumable(runs, out, executor, "ncap", progress)
 
 
 def read_results(out: Path, runs: list[NcapRun]) -> list[dict[str, Any]]:
     """The result lines of `runs` (this code's), in the runs' order."""
-    wanted = {r.id for r in runs}
-    rows = {row["id"]: row for row in read_rows(out) if row["id"] in wanted}
-    return [rows[r.id] for r in runs if r.id in rows]
+    return rows_of(out, runs)

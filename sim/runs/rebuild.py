@@ -10,8 +10,12 @@ for the same scenario and code, so the line of the run done again equals the sto
 measured times, code and recording name aside.
 
 Each kind of result line is a `LineKind`: how to tell its lines, and how to rebuild and
-run one. Sweep lines are the one kind today; a Euro NCAP grid's line (sim.runs.ncap_grid)
-becomes a second one once it stores what an exact replay needs.
+run one. Three kinds: a sweep's lines; a closed loop's (sim.runs.closed_loop_grid: the
+scenario's source, file and given values or the placed case, the policy, the latency
+setting); a Euro NCAP grid's (sim.runs.ncap_grid: the protocol and car files, the grid
+point, role and draw, the latency setting). The closed-loop and grid runs compare their
+outcome, the host's times left out; a run made with the measured latency is replayed
+with the latency it measured on each frame (`outcome.latencies_ms`), so it is the same.
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from monopic.errors import UserError
-from sim.runs.result import ABLATION, RunResult
+from sim.runs.result import ABLATION, RunResult, values_said
 from sim.runs.results_file import read_rows
 from sim.runs.run_spec import RunSpec
 from sim.runs.sweep import TREE_TAG, run_scenario, tree_digest
@@ -41,11 +45,15 @@ IGNORED = ("timing", "code", "recording")
 
 @dataclass(frozen=True)
 class Rerun:
-    """One line's run done again: the line as stored and as it came out now."""
+    """One line's run done again: the line as stored and as it came out now (the keys
+    compared), the recording, the run in words ("(case5, robot.speed = 2): 30 frames,
+    contact at 1.93 s") and, if it failed when run again, its error."""
 
     stored: dict[str, Any]
     again: dict[str, Any]
     recording: Path
+    said: str = ""
+    failed: str | None = None
 
 
 @dataclass(frozen=True)
@@ -67,12 +75,16 @@ class LineKind:
     `tells(line)`: whether a line is of this kind. `rebuild(line, asked)`: the run as a
     worker receives it, recording into `asked.out` (UserError, one line, when the line
     cannot be rebuilt: nothing is run or written then). `rerun(line, run, asked)`: that
-    run done again, beside the stored line."""
+    run done again, beside the stored line. `same`: what a rerun that matches its line
+    gave ("frames and decisions"); `made_in`: where the line was made, as a difference
+    names it ("the sweep")."""
 
     name: str
     tells: Callable[[dict[str, Any]], bool]
     rebuild: Callable[[dict[str, Any], Asked], Any]
     rerun: Callable[[dict[str, Any], Any, Asked], Rerun]
+    same: str = "outcome"
+    made_in: str = "the run"
 
 
 def find_line(results: Path, run_id: str) -> dict[str, Any]:
@@ -86,8 +98,9 @@ def find_line(results: Path, run_id: str) -> dict[str, Any]:
         raise UserError(f"{results}: no finished runs in it yet")
     shown = ", ".join(repr(i) for i in ids[:2])
     raise UserError(
-        f"{results}: no run {run_id!r} in it ({len(ids)} runs, ids such as {shown}; "
-        f"`monopic report {results}` lists the runs that went wrong)"
+        f"{results}: no run {run_id!r} in it ({len(ids)} runs, ids such as {shown}; a sweep's "
+        "report, the closed loop's tables and the Euro NCAP report.md list the runs that went "
+        "wrong, each with its command)"
     )
 
 
@@ -152,10 +165,8 @@ def scenario_file_of(
     its id) is the run's: a file that does not is another file, or the file changed.
     UserError (one line) when none does, unless `anyway` (a line of other code, whose
     scenarios may digest differently): then the first file found."""
-    name = Path(row.file)
-    bases = [Path()] if name.is_absolute() else [Path(), results.parent, CHECKOUT]
-    found = list(dict.fromkeys(b / name for b in bases if (b / name).is_file()))
-    if not row.file or not found:
+    found = found_files(row.file, results) if row.file else []
+    if not found:
         raise UserError(
             f"{row.file or '(none)'}: no such scenario file (run {row.id} of {results} was made "
             "from it; a relative name is looked for from this folder, the results file's and "
@@ -206,15 +217,35 @@ def rebuild_sweep_line(line: dict[str, Any], asked: Asked) -> RunSpec:
 def rerun_sweep_line(line: dict[str, Any], spec: RunSpec, asked: Asked) -> Rerun:
     """A sweep's run done again on one worker of the sweep's own executor (so in the
     environment every sweep worker has), recording as `spec` says."""
+    from sim.runs.executors import work
+
+    again, failed = _on_one_worker(spec, work)
+    stored = _comparable(RunResult.from_json(line, str(asked.results)))
+    params = line.get("params") if isinstance(line.get("params"), dict) else {}
+    said = f"({line.get('family', '?')}, {values_said(params)})"
+    if failed is not None:
+        return Rerun(stored, {}, asked.out, said, failed)
+    made = RunResult.from_json(again)
+    said += f": {made.frames} frames, contact {_contact(made.contact_time)}"
+    return Rerun(stored, _comparable(made), asked.out, said)
+
+
+def _on_one_worker(
+    spec: Any, work: Callable[..., dict[str, Any]]
+) -> tuple[dict[str, Any], str | None]:
+    """`spec` run by `work` on one local worker of the executors every command uses (in
+    the environment each of their workers has): its row as plain JSON data, or its error."""
     from sim.runs.executors import local_executor
 
     came: list[dict[str, Any]] = []
-    local_executor(1)([spec], came.append)
+    local_executor(1, run=work)([spec], came.append)
     (again,) = came
-    if "error" in again:
-        raise RuntimeError(f"run {spec.id} failed when run again:\n{again['error']}")
-    stored = RunResult.from_json(line, str(asked.results))
-    return Rerun(_comparable(stored), _comparable(RunResult.from_json(again)), asked.out)
+    # As a results file holds it (tuples are lists there), to compare with a stored line.
+    return json.loads(json.dumps(again)), again.get("error")
+
+
+def _contact(time: object) -> str:
+    return f"at {time:.2f} s" if isinstance(time, int | float) else "none"
 
 
 def _comparable(result: RunResult) -> dict[str, Any]:
@@ -223,8 +254,191 @@ def _comparable(result: RunResult) -> dict[str, Any]:
     return {k: v for k, v in plain.items() if k not in IGNORED}
 
 
-SWEEP = LineKind("sweep", is_sweep_line, rebuild_sweep_line, rerun_sweep_line)
-KINDS: tuple[LineKind, ...] = (SWEEP,)
+SWEEP = LineKind(
+    "sweep",
+    is_sweep_line,
+    rebuild_sweep_line,
+    rerun_sweep_line,
+    same="frames and decisions",
+    made_in="the sweep",
+)
+
+
+# -- files named by a line ---------------------------------------------------------------
+
+
+def found_files(name: str, results: Path) -> list[Path]:
+    """The files a line's relative `name` may be: from this folder, the results file's
+    and the checkout's top folder (where `make demo` runs); an absolute name as it is."""
+    path = Path(name)
+    bases = [Path()] if path.is_absolute() else [Path(), results.parent, CHECKOUT]
+    return list(dict.fromkeys(b / path for b in bases if (b / path).is_file()))
+
+
+def _not_a_line(line: dict[str, Any], asked: Asked, what: str, err: Exception) -> UserError:
+    return UserError(
+        f"{asked.results}: run {line.get('id')} is not {what} line as this code reads them "
+        f"({type(err).__name__}: {err})"
+    )
+
+
+# -- closed-loop lines --------------------------------------------------------------------
+
+
+def is_loop_line(row: dict[str, Any]) -> bool:
+    return isinstance(row.get("source"), dict) and isinstance(row.get("outcome"), dict)
+
+
+def rebuild_loop_line(line: dict[str, Any], asked: Asked) -> Any:
+    """The closed-loop run of a line (sim.runs.closed_loop_grid.LoopRun), its scenario
+    rebuilt from the file and the values given (or the placed case), with the latencies it
+    measured when it applied the measured latency; UserError (one line) when the scenario
+    file is missing or no longer gives the run (the id's digest), unless `asked.anyway`."""
+    from sim.runs import closed_loop_grid as grid
+    from sim.runs.latency import LatencySetting, replay_latencies
+
+    try:
+        source = grid.Source.from_json(line["source"])
+        latency = LatencySetting.from_json(line["latency"])
+        policy = str(line["policy"])
+        replay = replay_latencies(line)
+    except (KeyError, TypeError, ValueError) as err:
+        raise _not_a_line(line, asked, "a closed loop's", err) from None
+    files: list[Path | None] = [None]
+    if source.file is not None:
+        files = list(found_files(source.file, asked.results))
+        if not files:
+            raise UserError(
+                f"{source.file}: no such scenario file (run {line['id']} of {asked.results} "
+                "was made from it; a relative name is looked for from this folder, the "
+                "results file's and the checkout's: run this from the folder the closed loop "
+                "ran in)"
+            )
+    made = []
+    for path in files:
+        scenario = source.scenario(load(path) if path is not None else None)
+        made.append(grid.loop_run(scenario, policy, source, latency, str(asked.out)))
+        if made[-1].id == line["id"]:
+            break
+    else:
+        if not asked.anyway:
+            where = files[0] if files[0] is not None else f"case {source.case}"
+            raise UserError(
+                f"{where}: it no longer gives run {line['id']} of {asked.results} (with the "
+                f"values given its run is {made[0].id}): the scenario changed since the "
+                "closed loop ran; restore it (e.g. from version control) to run it again"
+            )
+    run = made[-1] if made[-1].id == line["id"] else made[0]
+    return replace(
+        run,
+        id=line["id"],
+        scenario=replace(run.scenario, name=str(line.get("scenario", run.scenario.name))),
+        replay=None if replay is None else tuple(replay),
+    )
+
+
+def rerun_loop_line(line: dict[str, Any], run: Any, asked: Asked) -> Rerun:
+    """A closed-loop run done again on one worker, its row compared without the host's
+    times (sim.runs.closed_loop_grid.without_timing)."""
+    from sim.runs import closed_loop_grid as grid
+
+    again, failed = _on_one_worker(run, grid.work)
+    said = f"({grid.source_said(line['source'])}, policy {line['policy']})"
+    if failed is not None:
+        return Rerun(grid.without_timing(line), {}, asked.out, said, failed)
+    o = again["outcome"]
+    said += f": {o['frames']} frames, contact {_contact(o['contact_time'])}"
+    return Rerun(grid.without_timing(line), grid.without_timing(again), asked.out, said)
+
+
+LOOP = LineKind("closed-loop", is_loop_line, rebuild_loop_line, rerun_loop_line)
+
+
+# -- Euro NCAP grid lines -----------------------------------------------------------------
+
+
+def is_ncap_line(row: dict[str, Any]) -> bool:
+    from sim.runs.ncap_grid import GRID, NEAR_MISS, VERIFY
+
+    return isinstance(row.get("outcome"), dict) and row.get("role") in (GRID, VERIFY, NEAR_MISS)
+
+
+def rebuild_ncap_line(line: dict[str, Any], asked: Asked) -> Any:
+    """The grid's run of a line (sim.runs.ncap_grid.NcapRun), re-made from the protocol
+    and car files the line names (lines without them: the shipped ones) and matched by
+    its id, with the latencies it measured when it applied the measured latency;
+    UserError (one line) when a file is missing or they no longer give the run."""
+    from sim.runs import ncap_grid
+    from sim.runs.latency import replay_latencies
+    from sim.scenario.ncap import CAR_FILE, PROTOCOL_FILE, load_car, load_protocol
+
+    named = {"protocol": line.get("protocol") or str(PROTOCOL_FILE),
+             "car": line.get("car") or str(CAR_FILE)}  # fmt: skip
+    found = {}
+    for key, name in named.items():
+        found[key] = found_files(str(name), asked.results)
+        if not found[key]:
+            raise UserError(
+                f"{name}: no such {key} file (run {line.get('id')} of {asked.results} was made "
+                "from it; a relative name is looked for from this folder, the results file's "
+                "and the checkout's: run this from the folder the grid ran in)"
+            )
+    made = []
+    try:
+        replay = replay_latencies(line)
+        for protocol_path, car_path in [(p, c) for p in found["protocol"] for c in found["car"]]:
+            protocol, car = load_protocol(protocol_path), load_car(car_path)
+            made.append(ncap_grid.run_of(protocol, car, line))
+            if made[-1].id == line["id"]:
+                break
+    except (KeyError, TypeError, ValueError) as err:
+        raise _not_a_line(line, asked, "a Euro NCAP grid's", err) from None
+    run = made[-1]
+    if run.id != line["id"]:
+        if not asked.anyway:
+            raise UserError(
+                f"{found['protocol'][0]}, {found['car'][0]}: they no longer give run "
+                f"{line['id']} of {asked.results} (rebuilt from them it is {made[0].id}): a "
+                "file changed since the grid ran; restore it (e.g. from version control) to "
+                "run it again"
+            )
+        run = made[0]
+    # The row names the files as the grid's command was given them, not as found here.
+    meta = {k: v for k, v in run.meta.items() if k not in named or k in line}
+    meta.update({k: line[k] for k in named if k in line})
+    return replace(
+        run,
+        id=line["id"],
+        scenario=replace(run.scenario, name=line["id"]),
+        meta=meta,
+        replay=None if replay is None else tuple(replay),
+        rrd=str(asked.out),
+    )
+
+
+def _ncap_comparable(row: dict[str, Any]) -> dict[str, Any]:
+    from sim.runs.ncap_grid import without_timing
+
+    return {k: v for k, v in without_timing(row).items() if k != "code"}
+
+
+def rerun_ncap_line(line: dict[str, Any], run: Any, asked: Asked) -> Rerun:
+    """A grid's run done again on one worker, its row compared without the host's times
+    and the code (sim.runs.ncap_grid.without_timing)."""
+    from sim.runs import ncap_grid
+
+    again, failed = _on_one_worker(run, ncap_grid.work)
+    said = f"({ncap_grid.run_said(line)}, policy {line['policy']})"
+    if failed is not None:
+        return Rerun(_ncap_comparable(line), {}, asked.out, said, failed)
+    o = again["outcome"]
+    hit = f"contact at {3.6 * o['impact_speed']:.1f} km/h" if o["contact"] else "no contact"
+    said += f": {o['frames']} frames, {hit}"
+    return Rerun(_ncap_comparable(line), _ncap_comparable(again), asked.out, said)
+
+
+NCAP = LineKind("Euro NCAP", is_ncap_line, rebuild_ncap_line, rerun_ncap_line)
+KINDS: tuple[LineKind, ...] = (SWEEP, LOOP, NCAP)
 
 
 def kind_of(line: dict[str, Any]) -> LineKind | None:
@@ -234,12 +448,15 @@ def kind_of(line: dict[str, Any]) -> LineKind | None:
 # -- comparing --------------------------------------------------------------------------
 
 
-def first_difference(stored: dict[str, Any], again: dict[str, Any]) -> str | None:
+def first_difference(
+    stored: dict[str, Any], again: dict[str, Any], made_in: str = "the sweep"
+) -> str | None:
     """Where the line run again first differs from the stored one, in words; None if equal.
 
     Keys in the line's order, so a different frame count is named before the columns it
-    makes differ; a per-frame column names its frame and time."""
-    for path, said in _differences(stored, again, ()):
+    makes differ; a per-frame column names its frame and time. `made_in`: where the line
+    was made ("the sweep", "the run"), as the words say it."""
+    for path, said in _differences(stored, again, (), made_in):
         return f"{_where(path, stored)}: {said}"
     return None
 
@@ -247,18 +464,20 @@ def first_difference(stored: dict[str, Any], again: dict[str, Any]) -> str | Non
 _ABSENT = object()
 
 
-def _differences(a: Any, b: Any, path: tuple[str | int, ...]) -> Iterator[tuple[tuple, str]]:
+def _differences(
+    a: Any, b: Any, path: tuple[str | int, ...], made_in: str
+) -> Iterator[tuple[tuple, str]]:
     """(path, what differs) of every difference, depth first in the stored line's order."""
     if isinstance(a, dict) and isinstance(b, dict):
         for key in [*a, *(k for k in b if k not in a)]:
-            yield from _differences(a.get(key, _ABSENT), b.get(key, _ABSENT), (*path, key))
+            yield from _differences(a.get(key, _ABSENT), b.get(key, _ABSENT), (*path, key), made_in)
     elif isinstance(a, list) and isinstance(b, list):
         for k, (x, y) in enumerate(zip(a, b, strict=False)):
-            yield from _differences(x, y, (*path, k))
+            yield from _differences(x, y, (*path, k), made_in)
         if len(a) != len(b):
-            yield path, f"{len(a)} entries in the sweep, {len(b)} now"
+            yield path, f"{len(a)} entries in {made_in}, {len(b)} now"
     elif a != b or type(a) is not type(b):
-        yield path, f"{_shown(a)} in the sweep, {_shown(b)} now"
+        yield path, f"{_shown(a)} in {made_in}, {_shown(b)} now"
 
 
 def _where(path: tuple[str | int, ...], line: dict[str, Any]) -> str:

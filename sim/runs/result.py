@@ -201,6 +201,15 @@ class RunResult:
 OLD_PREDICTOR_NAMES = {"id3-tree": "tree"}
 
 
+def values_said(params: dict[str, Any]) -> str:
+    """A run's given or swept values in words, 'robot.speed = 2, duration = 2', or "the
+    file's values" (reports and `monopic rerun` name runs so)."""
+    if not params:
+        return "the file's values"
+    return ", ".join(f"{k} = {v:g}" if isinstance(v, float) else f"{k} = {v}"
+                     for k, v in params.items())  # fmt: skip
+
+
 def current_key(key: str) -> str:
     """A decision key ("id3-tree/image") in today's vocabulary ("tree/image")."""
     name, slash, mode = key.partition("/")

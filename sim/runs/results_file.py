@@ -15,6 +15,7 @@ import errno
 import fcntl
 import json
 import os
+import sys
 from collections import Counter
 from collections.abc import Iterator
 from dataclasses import dataclass, field
@@ -106,6 +107,45 @@ def read_results(path: Path) -> Iterator[RunResult]:
     """Every complete result line as a record; a line that does not fit names its number."""
     for number, row in enumerate(read_rows(path), start=1):
         yield RunResult.from_json(row, f"{path}:{number}")
+
+
+def check_resumable(out: Path, schema: int, restart: bool, option: str = "--out") -> None:
+    """The checks a resumable results file gets before its runs (the Euro NCAP grid's, the
+    closed loop's; a sweep's make these and more, sim.runs.sweep.check_output).
+
+    A file holding lines of other code or of a schema newer than `schema` is refused in
+    one line naming `option`, unless `restart`: then it is set aside as
+    <name>.<code>.jsonl (never over an earlier one). One another process is appending to
+    is refused before anything is set aside (its lock)."""
+    from sim.runs.code_version import code_version
+
+    if out.is_dir():
+        raise UserError(f"{option} {out}: is a folder; give a file name")
+    if not out.exists():
+        return
+    code = code_version()
+    state = scan(out)
+    other = state.other_code(code)
+    newer = state.newer_schema(schema)
+    if newer and not restart:
+        raise UserError(
+            f"{out}:{newer[0]}: a result of schema {newer[1]}, newer than this code's "
+            f"{schema} (written by newer code, which alone reads it); use another {option}, or "
+            "--restart to set the file aside and start over"
+        )
+    if other and not restart:
+        raise UserError(
+            f"{out}: holds runs of other code ({', '.join(other)}; this code is {code}); "
+            f"use another {option}, or --restart to set them aside and start over"
+        )
+    check_unlocked(out)
+    if other or newer:
+        tag = (next(iter(other)) if len(other) == 1 else "mixed") if other else f"schema{newer[1]}"
+        target = out.with_name(f"{out.stem}.{tag}{out.suffix}")
+        if target.exists():
+            raise UserError(f"{target}: already there; move it away to restart {out}")
+        out.rename(target)
+        print(f"set aside: {out} -> {target}", file=sys.stderr)
 
 
 LOCKED = "{path}: another sweep is writing to it; wait for it or use another --out"

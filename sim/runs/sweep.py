@@ -40,7 +40,7 @@ from monopic.errors import UserError
 from monopic.output import stale_temporaries_cleared
 from sim.runs.code_version import code_version
 from sim.runs.result import SCHEMA
-from sim.runs.results_file import ResultsState, ResultsWriter, check_unlocked, scan
+from sim.runs.results_file import ResultsState, ResultsWriter, check_unlocked, read_rows, scan
 from sim.runs.run_spec import RunSpec
 from sim.scenario.files import (
     ScenarioFile,
@@ -456,6 +456,38 @@ def run_sweep(
             say_skipped(out, skipped, len(runs), len(todo))
         finished, failed = run_missing(todo, executor, writer, spec.name, progress)
     return SweepOutcome(len(runs), skipped, finished, tuple(failed), time.perf_counter() - start)
+
+
+class Resumable(Protocol):
+    """A run as the Euro NCAP grid and the closed loop hand them to their workers: a
+    frozen dataclass with its id and the code version its line will carry."""
+
+    id: str
+    code: str
+
+
+def run_resumable(
+    runs: Sequence[Resumable], out: Path, executor: Executor, desc: str, progress: bool = True
+) -> SweepOutcome:
+    """Run every run missing from the results file `out` (by id), appending each result
+    line as it finishes, each stamped with this code's version (resumed as a sweep is)."""
+    code = code_version()
+    stamped = [replace(r, code=code) for r in runs]  # type: ignore[type-var]
+    with ResultsWriter(out) as writer:
+        todo = [r for r in stamped if r.id not in writer.state.ids]
+        skipped = len(stamped) - len(todo)
+        start = time.perf_counter()
+        if skipped and progress:
+            say_skipped(out, skipped, len(stamped), len(todo))
+        finished, failed = run_missing(todo, executor, writer, desc, progress)
+    return SweepOutcome(len(runs), skipped, finished, tuple(failed), time.perf_counter() - start)
+
+
+def rows_of(out: Path, runs: Sequence[Resumable]) -> list[dict[str, Any]]:
+    """The result lines of `runs` in a results file, in the runs' order (one each)."""
+    wanted = {r.id for r in runs}
+    rows = {row["id"]: row for row in read_rows(out) if row["id"] in wanted}
+    return [rows[r.id] for r in runs if r.id in rows]
 
 
 def say_skipped(out: Path, skipped: int, total: int, todo: int) -> None:

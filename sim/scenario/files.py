@@ -353,7 +353,7 @@ def unsweepable(key: str) -> str | None:
 @dataclass(frozen=True)
 class Given:
     """A value given on the command line for a key of a scenario file (record's --robot-speed
-    for robot.speed, closed-loop's --speeds ...): applied as the file's own value would be."""
+    for robot.speed, closed-loop's --robot-speeds ...): applied as the file's own value would be."""
 
     option: str  # as typed, e.g. "--robot-speed"
     key: str  # the file's dotted key, e.g. "robot.speed"

@@ -476,7 +476,7 @@ def test_closed_loop_and_dataset_make_their_output_folders(
     scenario.write_text(TINY.split("[sweep]")[0])
     table = tmp_path / "a" / "b" / "table.md"
     rrd_dir = tmp_path / "c" / "rrd"
-    argv = ["closed-loop", str(scenario), "--speeds", "1", "--policies", "none,truth"]
+    argv = ["closed-loop", str(scenario), "--robot-speeds", "1", "--policies", "none,truth"]
     assert main([*argv, "--out", str(table), "--rrd-dir", str(rrd_dir)]) == 0
     assert table.read_text().startswith("# Closed loop") and rrd_dir.is_dir()
     spec = tmp_path / "spec.toml"

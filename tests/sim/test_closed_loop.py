@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 import pytest
 
@@ -90,31 +91,72 @@ def test_braking_on_the_ground_mode_warning_avoids_contacts():
             "(constant-velocity|intent-tree|rules|tree)",
         ),
         (["--cases", "5", "--policies", "rules/sky"], "'rules/sky' is not a policy"),
-        (["--cases", "5", "--speeds", "fast"], "--speeds: expected numbers"),
+        (["--cases", "5", "--robot-speeds", "fast"], "--robot-speeds: expected numbers"),
         # a case placement gets a small-scale file's checks: the small robot's max_speed
-        (["--cases", "5", "--speeds", "10"], "--speeds 10: case 5: must be <= 3 m/s"),
+        (["--cases", "5", "--robot-speeds", "10"], "--robot-speeds 10: case 5: must be <= 3 m/s"),
         # a file's own max_speed, named with the option and the file
         (
-            ["scenarios/families/car/cpna25.toml", "--speeds", "25"],
-            "--speeds 25: scenarios/families/car/cpna25.toml: robot.speed = 25.0: must be "
-            "<= 20 m/s (robot.max_speed)",
+            ["scenarios/families/car/cpna25.toml", "--robot-speeds", "25"],
+            "--robot-speeds 25: scenarios/families/car/cpna25.toml: robot.speed = 25.0: must "
+            "be <= 20 m/s (robot.max_speed)",
+        ),
+        # the help's range is the option's; the scenario file's seed range bounds it above
+        (
+            ["scenarios/families/car/cpna25.toml", "--seed", "2147483648"],
+            "--seed 2147483648: scenarios/families/car/cpna25.toml: seed = 2147483648: must be "
+            "an integer in [0, 2147483647]",
+        ),
+        (["--cases", "5", "--address", "host:1"], "--address is for --executor ray"),
+        (
+            ["--cases", "5", "--results", "scenarios"],
+            "--results scenarios: is a folder; give a file name",
         ),
         (
-            ["scenarios/families/car/cpna25.toml", "--seed", "-2"],
-            "--seed -2: scenarios/families/car/cpna25.toml: seed = -2: must be an integer",
+            ["--cases", "5", "--out", "nowhere/t.jsonl"],
+            "--out nowhere/t.jsonl: the tables would overwrite the results file nowhere/t.jsonl",
         ),
     ],
 )
 def test_closed_loop_command_rejects_bad_input_in_one_line(capsys, monkeypatch, argv, expected):
-    import sim.runs.closed_loop
+    import sim.runs.closed_loop_grid
 
     def no_run(*args, **kwargs):
         raise AssertionError("a run started before the input was checked")
 
-    monkeypatch.setattr(sim.runs.closed_loop, "run_closed_loop", no_run)
+    monkeypatch.setattr(sim.runs.closed_loop_grid, "run_runs", no_run)
     assert main(["closed-loop", *argv]) == 2
     err = capsys.readouterr().err.strip()
     assert len(err.splitlines()) == 1 and expected in err
+
+
+@pytest.mark.parametrize(
+    ("argv", "expected"),
+    [
+        (["--seed", "-2"], "argument --seed: must be >= 0, got '-2'"),
+        (["--latency-ms", "-1"], "argument --latency-ms: must be >= 0, got '-1'"),
+        (["--workers", "0"], "argument --workers: must be >= 1, got '0'"),
+    ],
+)
+def test_ranged_options_are_refused_by_the_command_line_in_one_line(capsys, argv, expected):
+    with pytest.raises(SystemExit) as stop:  # argparse's own refusal (monopic.cli.main)
+        main(["closed-loop", "--cases", "5", *argv])
+    assert stop.value.code == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and expected in err
+
+
+def test_speeds_is_a_deprecated_name_of_robot_speeds(capsys):
+    from monopic.cli.main import build_parser
+
+    args = build_parser().parse_args(["closed-loop", "--cases", "5", "--speeds", "1,2"])
+    assert args.robot_speeds == "1,2"
+    assert capsys.readouterr().err == (
+        "monopic closed-loop: warning: --speeds is deprecated, use --robot-speeds\n"
+    )
+    with pytest.raises(SystemExit):
+        build_parser().parse_args(["closed-loop", "--help"])
+    shown = capsys.readouterr().out
+    assert "--robot-speeds" in shown and "--speeds" not in shown.replace("--robot-speeds", "")
 
 
 CAR_FILE = """
@@ -135,26 +177,165 @@ distance = 4.0
 
 
 def test_a_file_runs_at_its_own_speed_and_seed_unless_given(tmp_path):
-    """closed-loop FILE: the file's robot.speed and seed are the defaults; --speeds and
-    --seed replace them (the default families too: each at its own speed and seed)."""
-    from sim.commands.closed_loop import FAMILY_FOLDER, NCAP_FAMILIES, file_scenarios
+    """closed-loop FILE: the file's robot.speed and seed are the defaults; --robot-speeds
+    and --seed replace them (the default families too: each at its own speed and seed)."""
+    from sim.commands.closed_loop import FAMILY_FOLDER, NCAP_FAMILIES
+    from sim.runs.closed_loop_grid import file_sources, scenarios_of
     from sim.scenario.files import load
 
     path = tmp_path / "car.toml"
     path.write_text(CAR_FILE)
     table = tmp_path / "table.md"
-    assert main(["closed-loop", str(path), "--policies", "none", "--out", str(table)]) == 0
+    argv = ["closed-loop", str(path), "--policies", "none", "--out", str(table), "--workers", "1"]
+    assert main(argv) == 0
     text = table.read_text()
     assert "1 scenarios" in text and "robot speeds 8.33 m/s: each file's own" in text
     assert "seed 5 (each file's own)" in text
     assert "| child-at-30@8.33 | none | yes | 8.33 |" in text  # hit at the file's speed
-    given = file_scenarios([path], [4.0, 6.0], 9)
+    given = scenarios_of(file_sources([path], [4.0, 6.0], 9))
     assert [(s.name, s.robot.speed, s.seed) for s in given] == [
         ("child-at-30@4", 4.0, 9),
         ("child-at-30@6", 6.0, 9),
     ]
     families = [FAMILY_FOLDER / f"{name}.toml" for name in NCAP_FAMILIES]
-    own = file_scenarios(families, None, None)
+    own = scenarios_of(file_sources(families, None, None))
     assert [(s.robot.speed, s.seed) for s in own] == [
         (load(f).base.robot.speed, load(f).base.seed) for f in families
     ]
+
+
+# -- the runs on workers, their results file, rerun ----------------------------------------
+
+# A crossing meeting the small robot at 2 s: rules/ground warns on it and brakes.
+MEETING = """
+name = "meet{case}"
+scale = "small"
+duration = 2.6
+[robot]
+speed = 2.0
+[robot.camera]
+width = 384
+height = 216
+[path]
+kind = "case"
+case = {case}
+distance = 4.0
+meet_time = 2.0
+"""
+POLICIES = "none,truth,rules/ground"
+
+
+def _meeting(tmp_path, case: int = 5):
+    path = tmp_path / f"meet{case}.toml"
+    path.write_text(MEETING.format(case=case))
+    return path
+
+
+def _rows(path):
+    from sim.runs.results_file import read_rows
+
+    return list(read_rows(path))
+
+
+def _section(text: str, title: str) -> str:
+    return text.split(f"{title}\n\n", 1)[1].split("\n\n", 1)[0]
+
+
+@pytest.mark.slow
+def test_the_runs_on_workers_give_the_in_process_tables_with_one_or_two_workers(tmp_path):
+    """The tables are made from the results rows; they are the tables the runs give in
+    this process (the measured pipeline latency aside: a fixed latency is applied, so
+    nothing else depends on the host), and one or two workers give the same rows."""
+    from dataclasses import replace
+
+    from sim.runs.closed_loop import format_runs
+    from sim.runs.closed_loop_grid import (
+        expand,
+        file_sources,
+        outcome_of,
+        scenarios_of,
+        without_timing,
+    )
+    from sim.runs.latency import FIXED, LatencySetting
+
+    files = [_meeting(tmp_path, 5), _meeting(tmp_path, 6)]
+    tables = []
+    for workers in (1, 2):
+        table = tmp_path / f"w{workers}.md"
+        argv = ["closed-loop", *map(str, files), "--policies", POLICIES, "--latency-ms", "100",
+                "--workers", str(workers), "--out", str(table)]  # fmt: skip
+        assert main(argv) == 0
+        tables.append(table)
+    # The lines in the order the runs finished; the tables in the runs' order.
+    one, two = ({r["id"]: r for r in _rows(t.with_suffix(".jsonl"))} for t in tables)
+    assert len(one) == 6 and {k: without_timing(r) for k, r in one.items()} == {
+        k: without_timing(r) for k, r in two.items()
+    }
+
+    scenarios = scenarios_of(file_sources(files, None, None))
+    here = [run_closed_loop(s, p, seed=s.seed, latency_ms=100.0)
+            for s in scenarios for p in POLICIES.split(",")]  # fmt: skip
+    runs = expand(file_sources(files, None, None), scenarios, POLICIES.split(","),
+                  LatencySetting(FIXED, 100.0))  # fmt: skip
+    made = [outcome_of(two[r.id]) for r in runs]
+
+    def host_free(o):
+        return replace(o, latencies_ms=())
+
+    assert [host_free(o) for o in made] == [host_free(o) for o in here]
+    text = tables[1].read_text()
+    assert _section(text, "## Runs") == format_runs(here)
+    assert format_table(summarise(made)) in text  # the measured latency median: the rows'
+    unmeasured = [replace(r, latency_ms_median=None) for r in summarise(made)]
+    assert format_table(unmeasured) == format_table(
+        [replace(r, latency_ms_median=None) for r in summarise(here)]
+    )
+    assert "| rules/ground | 2 |" in text and "## Runs to look at" in text
+
+
+@pytest.mark.slow
+def test_rerun_gives_a_closed_loop_runs_outcome_and_recording_with_its_latencies(tmp_path, capsys):
+    """A run made with the measured latency is made again with the latency it measured on
+    each frame: a row whose host measured 200 ms per frame (its brake acts 3 frames late)
+    gives its outcome again on a host that measures far less."""
+    import json
+    from dataclasses import asdict
+
+    from sim.runs.closed_loop_grid import Source
+    from tests.rrd import rows_per_entity
+
+    path = _meeting(tmp_path)
+    results, rrd_dir = tmp_path / "r.jsonl", tmp_path / "rrd"
+    argv = ["closed-loop", str(path), "--policies", "rules/ground", "--results", str(results),
+            "--rrd-dir", str(rrd_dir), "--workers", "1"]  # fmt: skip
+    assert main(argv) == 0
+    capsys.readouterr()
+    none, braking = _rows(results)
+    assert braking["latency"] == {"source": "measured", "applied_ms": None}
+    assert none["policy"] == "none" and braking["outcome"]["brake_time"] is not None
+    assert braking["source"] == {"file": str(path), "case": None, "given": {}, "meet_time": None}
+
+    rrd = tmp_path / "again" / "run.rrd"
+    assert main(["rerun", str(results), braking["id"], "--out", str(rrd)]) == 0
+    said = capsys.readouterr().out
+    assert said.splitlines()[-1] == "same outcome as in the run", said
+    assert rows_per_entity(rrd) == rows_per_entity(Path(braking["recording"]))
+
+    # The same run, as if its host had measured 200 ms on every frame.
+    scenario = Source(file=str(path)).scenario()
+    slow = run_closed_loop(scenario, "rules/ground", seed=scenario.seed, latency_ms=200.0)
+    assert slow.braked and set(slow.delays) == {3}
+    line = json.loads(json.dumps({**braking, "outcome": asdict(slow)}))
+    line["outcome"]["latencies_ms"] = [200.0] * len(slow.latencies_ms)
+    measured = tmp_path / "measured.jsonl"
+    measured.write_text(json.dumps(line) + "\n")
+    assert main(["rerun", str(measured), line["id"]]) == 0
+    said = capsys.readouterr().out
+    assert said.splitlines()[-1] == "same outcome as in the run", said
+    assert (tmp_path / "measured_rerun" / f"{line['id']}.rrd").is_file()
+
+    # A line that does not hold what its run gives: the first difference, exit 1.
+    line["outcome"]["brake_time"] += 1.0
+    measured.write_text(json.dumps(line) + "\n")
+    assert main(["rerun", str(measured), line["id"]]) == 1
+    assert "first difference at outcome.brake_time: " in capsys.readouterr().out

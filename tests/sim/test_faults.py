@@ -543,21 +543,30 @@ def test_dataset_and_closed_loop_stop_within_seconds_with_their_line(
     assert temporaries(folder) == []
 
     scenario = sweep_spec(tmp_path, "loop", speeds(1), duration=3.0).with_name("loop.toml")
-    rrd = tmp_path / "loop_rrd"
+    rrd, results = tmp_path / "loop_rrd", tmp_path / "loop.jsonl"
     rrd.mkdir()
     loop = Command.start(
-        ["closed-loop", str(scenario), "--speeds", "1,2", "--policies", "none,truth",
-         "--rrd-dir", str(rrd)],
+        ["closed-loop", str(scenario), "--robot-speeds", "1,2", "--policies", "none,truth",
+         "--rrd-dir", str(rrd), "--results", str(results), *SWEEP_FLAGS],
         tmp_path,
         "loop",
     )  # fmt: skip
     commands.append(loop)
-    loop.wait_for(lambda: "| 1/4 [" in loop.text(), "a finished run")
+    loop_workers: set[int] = set()
+
+    def a_finished_loop_run() -> bool:
+        loop_workers.update(loop.workers())
+        return "| 1/4 [" in loop.text()
+
+    loop.wait_for(a_finished_loop_run, "a finished run")
+    assert len(loop_workers) == 2  # the closed loop's runs render on two spawned workers
     seconds = loop.stop(sig)
     assert seconds < STOP_BOUND_S and loop.proc.returncode == code
     assert loop.last_line() == f"monopic closed-loop: {word}"
     assert "Traceback" not in loop.text()
+    assert gone_within(loop_workers, STOP_BOUND_S), "a closed-loop worker lives on"
     assert temporaries(rrd) == []
+    assert lines(results) >= 1  # the finished run is kept
 
     out = tmp_path / "record" / "loop.rrd"
     out.parent.mkdir()

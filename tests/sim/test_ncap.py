@@ -20,7 +20,7 @@ from sim.analysis.ncap_score import Cell, band_colour, score
 from sim.runs import ncap_grid
 from sim.runs.aeb import AebParams, JerkLimitedBrake, run_aeb
 from sim.runs.executors import local_executor
-from sim.runs.latency import AppliedLatency
+from sim.runs.latency import AppliedLatency, replay_latencies
 from sim.runs.ncap_grid import DECLARED, FIXED, GRID, MEASURED, LatencySetting, latency_setting
 from sim.scenario.ncap import KMH, Draw, draw_for, grid, load_car, load_protocol, scenario_for
 from sim.scenario.path import pedestrian_path
@@ -231,6 +231,7 @@ def test_ncap_command_runs_scores_and_resumes(tmp_path, capsys):
     printed = capsys.readouterr().out
     report = (out / "report.md").read_text()
     assert "euroncap-rating-2026 5.4.9" in report and "matrix-rules-ground.png" in report
+    assert "## Runs to look at" in report  # each with `monopic rerun RESULTS RUN_ID`
     measured = measured_latency(rows)
     line = (
         f"Latency applied: declared {CAR.latency_ms:g} ms ({CAR.path} latency_ms). Pipeline "
@@ -372,7 +373,7 @@ def test_an_aeb_run_replayed_with_its_recorded_latencies_is_the_same_run():
     first = run_aeb(run.scenario, run.policy, run.aeb, seed=run.index)
     assert first.warning_time is not None and len(first.latencies_ms) > 0
     row = {"latency": run.latency.to_json(), "outcome": asdict(first)}
-    recorded = ncap_grid.replay_latencies(json.loads(json.dumps(row)))  # as stored
+    recorded = replay_latencies(json.loads(json.dumps(row)))  # as stored
     assert recorded == list(first.latencies_ms)
     again = run_aeb(run.scenario, run.policy, run.aeb, seed=run.index, latencies_ms=recorded)
     # The same frames and decisions: down to the float, the warning was issued at the
@@ -443,3 +444,92 @@ def test_the_renamed_options_still_work_and_say_they_are_deprecated(tmp_path, ca
     assert lines[1] == "monopic ncap: warning: --seeds is deprecated, use --runs-per-point"
     assert lines[2].startswith("monopic ncap: error: --speeds-kmh 90: not a test speed")
     assert len(lines) == 3 and not out.exists()
+# -- a grid's run again: monopic rerun ------------------------------------------------------
+
+
+@pytest.mark.slow
+def test_rerun_gives_a_grid_points_outcome_and_a_readable_recording(tmp_path, capsys):
+    from tests.rrd import rows_per_entity
+
+    results = tmp_path / "results.jsonl"
+    row = _one_run(results)  # the declared latency
+    assert row["protocol"] == str(PROTOCOL.path) and row["car"] == str(CAR.path)
+    rrd = tmp_path / "again" / "run.rrd"
+    assert main(["rerun", str(results), row["id"], "--out", str(rrd)]) == 0
+    said = capsys.readouterr().out
+    assert said.splitlines()[-1] == "same outcome as in the run", said
+    assert said.startswith(f"run {row['id']} (CPNA day AEB 20 km/h, impact 50%, grid run 0, ")
+    # Every processed frame's camera image, read back with rerun's own reader (a run that
+    # stops without contact counts the state it stopped in as a frame too).
+    frames = row["outcome"]["frames"] - (not row["outcome"]["contact"])
+    assert rows_per_entity(rrd)["/camera/image"] == frames > 0
+
+
+@pytest.mark.slow
+def test_a_measured_latency_grid_row_is_rerun_with_the_latency_it_measured(tmp_path, capsys):
+    """A row whose host measured 300 ms on every frame: its warning was issued 300 ms after
+    each warned frame's capture. Run again on a host that measures far less, it gives the
+    same outcome down to the float, because the rerun applies the stored latencies."""
+    from sim.runs.code_version import code_version
+
+    run = _cpna20(LatencySetting(MEASURED, None))[0]
+    fixed = replace(
+        run, aeb=replace(run.aeb, latency_ms=300.0), latency=LatencySetting(FIXED, 300.0)
+    )
+    frames = len(run_aeb(fixed.scenario, fixed.policy, fixed.aeb, seed=fixed.index).latencies_ms)
+    made = ncap_grid.work(replace(run, code=code_version(), replay=(300.0,) * frames))
+    assert "error" not in made and made["outcome"]["warning_time"] is not None
+    line = json.loads(json.dumps(made))
+    assert line["latency"] == {"source": MEASURED, "applied_ms": None}
+    line["outcome"]["latencies_ms"] = [300.0] * frames  # as that host measured them
+    results = tmp_path / "results.jsonl"
+    results.write_text(json.dumps(line) + "\n")
+    assert main(["rerun", str(results), line["id"]]) == 0
+    said = capsys.readouterr().out
+    assert said.splitlines()[-1] == "same outcome as in the run", said
+    assert (tmp_path / "results_rerun" / f"{line['id']}.rrd").is_file()  # the default --out
+
+    line["outcome"]["warning_ttc"] += 0.5  # not what the run gives: its first difference
+    results.write_text(json.dumps(line) + "\n")
+    assert main(["rerun", str(results), line["id"]]) == 1
+    assert "first difference at outcome.warning_ttc: " in capsys.readouterr().out
+
+
+def _grid_line(**changes) -> dict:
+    """A grid's results line of this code (its real id; an outcome nobody ran), changed."""
+    from sim.runs.code_version import code_version
+
+    run = replace(_cpna20()[0], code=code_version())
+    line = {"schema": 1, "id": run.id, "code": run.code, "policy": run.policy,
+            "role": run.role, "index": run.index, **run.meta,
+            "latency": run.latency.to_json(), "outcome": {"contact": False}}  # fmt: skip
+    line.update(changes)
+    return json.loads(json.dumps(line))
+
+
+@pytest.mark.parametrize(
+    ("changes", "run_id", "expected"),
+    [
+        ({}, "rules/ground/nope", "no run 'rules/ground/nope' in it (1 runs, ids such as"),
+        ({"code": "0123456789ab"}, None, "made by other code (0123456789ab; this code is"),
+        ({"car": "gone/car.toml"}, None, "gone/car.toml: no such car file"),
+        ({"protocol": "gone/p.toml"}, None, "gone/p.toml: no such protocol file"),
+        ({"car": "CHANGED"}, None, "they no longer give run rules/ground/cpna/AEB/20kmh/50/grid0-"),
+        ({"impact": 0.75}, None, "they no longer give run"),
+        ({"latency": {"source": "measured"}}, None, "is not a Euro NCAP grid's line as this"),
+    ],
+)
+def test_what_of_a_grid_cannot_be_rerun_is_one_line(tmp_path, capsys, changes, run_id, expected):
+    if changes.get("car") == "CHANGED":  # the car file edited since the grid ran
+        car = tmp_path / "car.toml"
+        car.write_text(CAR.path.read_text().replace("brake_delay = 0.15", "brake_delay = 0.2"))
+        assert car.read_text() != CAR.path.read_text()
+        changes = {"car": str(car)}
+    line = _grid_line(**changes)
+    results = tmp_path / "results.jsonl"
+    results.write_text(json.dumps(line) + "\n")
+    out = tmp_path / "out" / "run.rrd"
+    assert main(["rerun", str(results), run_id or line["id"], "--out", str(out)]) == 2
+    err = capsys.readouterr().err.strip()
+    assert "\n" not in err and expected in err, err
+    assert not (tmp_path / "out").exists()  # nothing made for a refused input

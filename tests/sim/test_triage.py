@@ -199,7 +199,7 @@ def _line(tmp_path: Path, **changes: object) -> dict:
         ({"params": {"robot.speed": 1.0}}, None, [], "no longer gives run tiny/0000-"),
         ({"code": code_version() + "+tree-0badc0de"}, None, [], "--intent-tree FILE"),
         ({}, None, ["--intent-tree", "spec.toml"], "ran no intent tree; leave it out"),
-        ({"policy": "rules/ground", "outcome": {}, "truth": None}, None, [], "Euro NCAP grid's"),
+        ({"truth": None}, None, [], "is not a run of a sweep, a closed loop or a Euro NCAP grid"),
     ],
 )
 def test_what_cannot_be_rerun_is_one_line(
@@ -241,3 +241,107 @@ def test_a_run_of_a_tree_not_shipped_says_its_rerun_needs_the_tree_file(tmp_path
     assert "`monopic rerun r.jsonl fam/own --intent-tree TREE`" in section
     assert "`monopic rerun r.jsonl fam/ours`" in section
     assert "TREE: the intent tree file the sweep spec names (`intent_tree`)" in section
+
+
+# -- closed-loop and Euro NCAP runs ----------------------------------------------------------
+
+
+def _loop_row(policy: str, scenario: str, contact: bool, braked: bool, impact: float = 2.0,
+              recording: str = "") -> dict:  # fmt: skip
+    from dataclasses import asdict
+
+    from sim.runs.closed_loop import LoopOutcome
+
+    o = LoopOutcome(scenario=scenario, policy=policy, seed=0, frames=30, contact=contact,
+                    contact_time=2.0 if contact else None, impact_speed=impact if contact else None,
+                    min_gap=0.0 if contact else 0.5, first_warning_time=1.0 if braked else None,
+                    brake_time=1.25 if braked else None, warned_frames=3 * braked,
+                    start_speed=2.0, final_speed=0.0 if braked else 2.0)  # fmt: skip
+    case = int(scenario[4])
+    source = {"file": None, "case": case, "given": {"robot.speed": 2.0}, "meet_time": 3.0}
+    return json.loads(json.dumps({"id": f"{policy}/{scenario}-0123abcd", "policy": policy,
+                                  "scenario": scenario, "seed": 0, "source": source,
+                                  "outcome": asdict(o), "recording": recording}))  # fmt: skip
+
+
+def test_the_closed_loop_lists_a_braking_policys_contacts_and_needless_stops(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from sim.analysis.triage import Rerunning, loop_triage_lines
+
+    monkeypatch.chdir(tmp_path)
+    kept = Path("rrd") / "case6@2-rules-ground.rrd"
+    kept.parent.mkdir()
+    kept.write_bytes(b"x")
+    rows = [
+        _loop_row("none", "case5@2", True, False),
+        _loop_row("rules/ground", "case5@2", True, True, impact=1.5),  # braked, still hit
+        _loop_row("truth", "case5@2", False, True),  # avoided: nothing to look at
+        _loop_row("none", "case6@2", True, False),
+        _loop_row("rules/ground", "case6@2", True, False, recording=str(kept)),  # missed
+        _loop_row("none", "case7@2", False, False),
+        _loop_row("rules/ground", "case7@2", False, True),  # braked without need
+        _loop_row("truth", "case7@2", False, False),
+    ]
+    where = Rerunning(Path("loop.jsonl"), Path("rrd"), Path())
+    text = "\n".join(loop_triage_lines(rows, where, recorded=True))
+    listed = [ln.split("`")[1] for ln in text.splitlines() if ln.startswith("- `")]
+    assert listed == [  # contacts by impact speed, then the needless stops; no baseline run
+        "rules/ground/case6@2-0123abcd",
+        "rules/ground/case5@2-0123abcd",
+        "rules/ground/case7@2-0123abcd",
+    ]
+    assert "**rules/ground**: 2 with contact, 1 braked without need of 3 runs" in text
+    assert "**truth**" not in text and "**none**" not in text
+    assert (
+        "- `rules/ground/case6@2-0123abcd` (case 6, robot.speed = 2): **contact at 2.00 m/s**; "
+        "recording [case6@2-rules-ground.rrd](rrd/case6@2-rules-ground.rrd)"
+    ) in text
+    assert "**braked without need (brake from 1.25 s)**; recording not kept" in text
+    assert "  `monopic rerun loop.jsonl rules/ground/case7@2-0123abcd`" in text
+    quiet = [r for r in rows if r["policy"] != "rules/ground"]
+    assert "None: no braking policy hit the pedestrian" in "\n".join(
+        loop_triage_lines(quiet, where)
+    )
+
+
+def _ncap_row(role: str, index: int, contact: bool, braked: bool, rel: float = 0.0) -> dict:
+    point = {"test": "cpna", "function": "AEB", "speed_kmh": 40.0, "impact": 0.5,
+             "load_case": "CPNA day"}  # fmt: skip
+    if role == "near-miss":
+        point = {"test": "near-miss", "family": "nearmiss_kerb_stop", "speed_kmh": 40.0}
+    outcome = {"contact": contact, "impact_speed": 5.0 if contact else None,
+               "relative_impact_speed": rel if contact else None,
+               "brake_time": 1.5 if braked else None}  # fmt: skip
+    return {"id": f"rules/ground/{point['test']}/{role}{index}-0123abcd", "policy": "rules/ground",
+            "role": role, "index": index, **point, "outcome": outcome}  # fmt: skip
+
+
+def test_the_ncap_report_lists_contacts_and_braked_near_misses_with_a_rerun_command() -> None:
+    from sim.analysis.triage import Rerunning, ncap_triage_lines
+
+    rows = [
+        _ncap_row("grid", 0, True, True, rel=2.0),
+        _ncap_row("grid", 1, True, True, rel=4.0),
+        _ncap_row("verify", 2, False, True),
+        _ncap_row("near-miss", 0, False, True),
+        _ncap_row("near-miss", 1, False, False),
+    ]
+    out = Path("recordings/ncap")
+    text = "\n".join(ncap_triage_lines(rows, Rerunning(out / "results.jsonl", out, out)))
+    listed = [ln.split("`")[1] for ln in text.splitlines() if ln.startswith("- `")]
+    assert listed == [
+        "rules/ground/cpna/grid1-0123abcd",
+        "rules/ground/cpna/grid0-0123abcd",
+        "rules/ground/near-miss/near-miss0-0123abcd",
+    ]
+    assert "**rules/ground, cpna**: 2 with contact of 3 runs" in text
+    assert "**rules/ground, near-miss**: 1 braked without need of 2 runs" in text
+    assert (
+        "- `rules/ground/cpna/grid1-0123abcd` (CPNA day AEB 40 km/h, impact 50%, grid run 1): "
+        "**contact at 18.0 km/h (14.4 km/h relative)**"
+    ) in text
+    assert "(nearmiss_kerb_stop at 40 km/h, seed 0): **braked without need (brake from" in text
+    assert (
+        "  `monopic rerun recordings/ncap/results.jsonl rules/ground/cpna/grid0-0123abcd`" in text
+    )
