@@ -444,6 +444,8 @@ def test_the_renamed_options_still_work_and_say_they_are_deprecated(tmp_path, ca
     assert lines[1] == "monopic ncap: warning: --seeds is deprecated, use --runs-per-point"
     assert lines[2].startswith("monopic ncap: error: --speeds-kmh 90: not a test speed")
     assert len(lines) == 3 and not out.exists()
+
+
 # -- a grid's run again: monopic rerun ------------------------------------------------------
 
 
