@@ -99,7 +99,7 @@ def capture(out: Path) -> None:
     )  # fmt: skip
     monopic("dataset", "scenarios/datasets/cases-heldout.toml", "--out", str(out / "ds"), log=log)
     monopic(
-        "closed-loop", *CLOSED_LOOP_FILES, "--speeds", "1,2", "--latency-ms", "60",
+        "closed-loop", *CLOSED_LOOP_FILES, "--robot-speeds", "1,2", "--latency-ms", "60",
         "--policies", "none,truth,rules/ground", "--out", str(out / "closed_loop.md"), log=log,
     )  # fmt: skip
     monopic("record", "5", "--out", str(out / "case5.rrd"), log=log)

@@ -30,11 +30,12 @@ def ranged(
     if low is None and high is None:
         raise ValueError("a range needs a low or a high end")
     if low is None:
-        text = f"{'<' if open_high else '<='} {high:g}"
+        text = f"{'<' if open_high else '<='} {_shown(high)}"
     elif high is None:
-        text = f"{'>' if open_low else '>='} {low:g}"
+        text = f"{'>' if open_low else '>='} {_shown(low)}"
     else:
-        text = f"{'(' if open_low else '['}{low:g}, {high:g}{')' if open_high else ']'}"
+        ends = f"{_shown(low)}, {_shown(high)}"
+        text = f"{'(' if open_low else '['}{ends}{')' if open_high else ']'}"
 
     def check(value_text: str) -> float:
         try:
@@ -53,6 +54,11 @@ def ranged(
     check.integer = integer  # type: ignore[attr-defined]
     check.open_low, check.open_high = open_low, open_high  # type: ignore[attr-defined]
     return check
+
+
+def _shown(value: float) -> str:
+    """A range's end as people write it: whole numbers in full (2147483647, not 2.14748e+09)."""
+    return str(int(value)) if float(value).is_integer() else f"{value:g}"
 
 
 class DeprecatedAlias(argparse.Action):

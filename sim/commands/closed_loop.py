@@ -82,9 +82,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     )
     p.add_argument(
         "--seed",
-        type=ranged(0, integer=True),
-        help="environment seed: the gait phase, an integer >= 0 (at most 2147483647, as a "
-        "scenario file's seed; default: each file's own seed; --cases: 0)",
+        type=ranged(0, 2**31 - 1, integer=True),
+        help="environment seed: the gait phase ([0, 2147483647], as a scenario file's seed; "
+        "default: each file's own seed; --cases: 0)",
     )
     p.add_argument("--out", type=Path, help="write the tables (Markdown) here")
     p.add_argument(
