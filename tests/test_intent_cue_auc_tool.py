@@ -11,8 +11,8 @@ import numpy as np
 import pytest
 
 from monopic.cases import Case
-from monopic.replay.intent_training import LabelledRow, RunRows
 from monopic.tree.intent import IntentSample
+from monopic.tree.intent_training import LabelledRow, RunRows
 from monopic.variants.zone import RobotGeometry
 from tests.paths import ROOT, load_tool
 

@@ -67,10 +67,10 @@ from monopic.features.window import Kinematics, SlidingWindow, angle_rate
 from monopic.frame import EgoState
 from monopic.output import atomic_path, write_text_atomically
 from monopic.predict.base import Prediction, with_ground_point
-from monopic.replay.intent_training import quantile_cuts
 from monopic.tree.discretise import CutPointBins, Discretiser
 from monopic.tree.id3 import DecisionTree, ID3Params, fit_id3
 from monopic.tree.intent import INTENT_ATTRIBUTES, IntentRules, LeafReading, place
+from monopic.tree.intent_training import quantile_cuts
 from sim.analysis.ground_replay import (
     PointRule,
     ReplayFrame,

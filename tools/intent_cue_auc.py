@@ -33,8 +33,8 @@ from pathlib import Path
 import numpy as np
 
 from monopic.errors import UserError
-from monopic.replay.intent_training import LabelledRow, RunRows, read_dataset
 from monopic.tree.intent import INTENT_ATTRIBUTES, INTENTS, ZONE_REACH, IntentSample
+from monopic.tree.intent_training import LabelledRow, RunRows, read_dataset
 
 STANDING_M_S = 0.3
 HOLD = "hold"  # stop or turn away: what the hold-back rule needs to know

@@ -30,14 +30,14 @@ from dataclasses import replace
 from pathlib import Path
 
 from monopic.errors import UserError
-from monopic.replay.intent_training import (
+from monopic.tree.intent import IntentRules, IntentSample, LeafReading, place
+from monopic.tree.intent_training import (
     RunCount,
     count_runs,
     read_dataset,
     split_runs,
     warned_frames,
 )
-from monopic.tree.intent import IntentRules, IntentSample, LeafReading, place
 from monopic.tree.serialise import load_intent_model
 
 STANDING_M_S = 0.3
