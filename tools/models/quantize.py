@@ -1,12 +1,13 @@
 """An int8 candidate of the landmark model or the detector, for bench/int8_*.py to judge.
 
-Static quantisation with onnxruntime's quantizer (QDQ format; `--format qoperator` for
-its QLinear operators): weights int8 per output channel, activations uint8 per tensor,
-ranges calibrated on landmark-model crops of rendered frames and the shipped clip (written
-by `bench/int8_landmarks.py crops`; the detector's windows with --detector, below). The
-shipped float model stores its weights as fp16 + Cast, which the quantizer would take for
-activations; they are turned back into float32 initializers first (lossless). The result
-is NOT shipped unless the judge says it keeps the float model's landmark error.
+Static quantisation with onnxruntime's quantizer (QDQ format; `--format qoperator` for its
+QLinear operators): weights int8 per output channel, activations uint8 per tensor, ranges
+calibrated on landmark-model crops of rendered frames and the shipped clip (written by
+`.venv/bin/python -m bench.int8_landmarks crops`; the detector's windows with --detector,
+below). The shipped float model stores its weights as fp16 + Cast, which the quantizer
+would take for activations; they are turned back into float32 initializers first
+(lossless). The result is NOT shipped unless the judge says it keeps the float model's
+landmark error.
 
     .venv-models/bin/python -m tools.models.quantize --crops recordings/int8/calibration.npz \
         --out recordings/int8/pose_landmark_full_int8.onnx [--method minmax|percentile|entropy]
@@ -21,8 +22,8 @@ high-resolution layers, the decoder and the heads in float.
 
 The candidate that keeps the float model's landmark error, shipped as
 monopic/pose/models/pose_landmark_full_int8.onnx (`make models-int8`; judged on the
-AVX-512 VNNI EPYC; `bench/int8_landmarks.py judge ... --rounds 6`: int8 - float +0.04
-[-0.14, +0.20] px on 559 frames, passes; 0.74 of the float time at 1 thread):
+AVX-512 VNNI EPYC; `.venv/bin/python -m bench.int8_landmarks judge ... --rounds 6`: int8 -
+float +0.04 [-0.14, +0.20] px on 559 frames, passes; 0.74 of the float time at 1 thread):
 
     .venv-models/bin/python -m tools.models.quantize --crops recordings/int8/calibration.npz \
         --out monopic/pose/models/pose_landmark_full_int8.onnx --method percentile \
@@ -67,38 +68,39 @@ time, no better than all int8.
 
 The detector (its search passes take about a quarter of a scenario run's time), for
 bench/int8_detector.py to judge, calibrated on the letterboxed detector windows (uint8,
-scaled to [-1, 1] as the detector takes them) written by `bench/int8_detector.py windows`.
-Every option above applies to it (--equalize and --gptq run the detector's own feeds;
---keep-heads keeps only its six output convolutions float). Its windows go through the
-calibrator in chunks (`_chunk`: it keeps every tensor of every input until the end, 34 GB
-for 600 windows). For the detector --float-ends keeps the stem (three convolutions, 112 px)
-and the feature pyramid float: every node the backbone's deepest tensor does not depend on
-(the top-down path from the first Resize, its lateral projections of the 28 and 14 px
-blocks, the six heads; 23 % of the MACs, the stem 4 %). The uint8 tensors there are what
-moved the detections (800 windows of the calibration frames that the calibration did not
-use): all int8 but the output tails, the regressed keypoints moved a median 0.8-2.7 px of
-the 224 px window, and decoding float scores with int8 boxes moved the detection as much
-as all int8, int8 scores with float boxes hardly at all; the heads float, still 0.4-1.4 px
-(their inputs uint8); the heads and the top-down path float, 0.1-0.5 px.
+scaled to [-1, 1] as the detector takes them) written by `.venv/bin/python -m
+bench.int8_detector windows`. Every option above applies to it (--equalize and --gptq run
+the detector's own feeds; --keep-heads keeps only its six output convolutions float). Its
+windows go through the calibrator in chunks (`_chunk`: it keeps every tensor of every
+input until the end, 34 GB for 600 windows). For the detector --float-ends keeps the stem
+(three convolutions, 112 px) and the feature pyramid float: every node the backbone's
+deepest tensor does not depend on (the top-down path from the first Resize, its lateral
+projections of the 28 and 14 px blocks, the six heads; 23 % of the MACs, the stem 4 %).
+The uint8 tensors there are what moved the detections (800 windows of the calibration
+frames that the calibration did not use): all int8 but the output tails, the regressed
+keypoints moved a median 0.8-2.7 px of the 224 px window, and decoding float scores with
+int8 boxes moved the detection as much as all int8, int8 scores with float boxes hardly at
+all; the heads float, still 0.4-1.4 px (their inputs uint8); the heads and the top-down
+path float, 0.1-0.5 px.
 
     .venv-models/bin/python -m tools.models.quantize --detector \
         --crops recordings/int8/detector_windows.npz \
         --out monopic/pose/models/pose_detection_int8.onnx \
         --method percentile --equalize 1.5 --float-ends --gptq
 
-`bench/int8_detector.py judge ... --no-append` (600 frames x 27 windows, the AVX-512 VNNI
-EPYC, 2026-12-03, load 3 from another job, so the time ratio is the alternated one):
-tracker found 98.2 % of frames with either detector (differing on 0 frames); windows found
-by one detector only 42 float, 10 int8 (of 4635 float finds); the farthest keypoint moved
-a median 1.0 % of the float box's height (p95 3.0 %); the tracker's landmark error, int8
-detector - float, -0.02 [-0.18, +0.17] px on 559 frames; 0.69 of the float pass time at 1
-thread (9.13 vs 13.22 ms). With min-max calibration and neither --equalize nor --gptq
-(`--detector --float-ends`): 54 / 12 windows, 1.2 % (p95 3.8 %), -0.05 [-0.19, +0.09] px,
-0.66 (load 1.0). All int8 but the output tails (`--method percentile --equalize 1.5
---gptq --keep-outputs`): 9 / 352 windows, the tracker 95.0 %, 7.5 % (p95 13.6 %), +0.38
-[+0.04, +0.80] px, 0.63. The first is shipped (`make models-int8`) as
-monopic/pose/models/pose_detection_int8.onnx, the tracker's `detector="int8"` choice;
-the default detector stays the float one.
+`.venv/bin/python -m bench.int8_detector judge ... --no-append` (600 frames x 27 windows,
+the AVX-512 VNNI EPYC, 2026-12-03, load 3 from another job, so the time ratio is the
+alternated one): tracker found 98.2 % of frames with either detector (differing on 0
+frames); windows found by one detector only 42 float, 10 int8 (of 4635 float finds); the
+farthest keypoint moved a median 1.0 % of the float box's height (p95 3.0 %); the
+tracker's landmark error, int8 detector - float, -0.02 [-0.18, +0.17] px on 559 frames;
+0.69 of the float pass time at 1 thread (9.13 vs 13.22 ms). With min-max calibration and
+neither --equalize nor --gptq (`--detector --float-ends`): 54 / 12 windows, 1.2 % (p95 3.8
+%), -0.05 [-0.19, +0.09] px, 0.66 (load 1.0). All int8 but the output tails (`--method
+percentile --equalize 1.5 --gptq --keep-outputs`): 9 / 352 windows, the tracker 95.0 %,
+7.5 % (p95 13.6 %), +0.38 [+0.04, +0.80] px, 0.63. The first is shipped (`make
+models-int8`) as monopic/pose/models/pose_detection_int8.onnx, the tracker's
+`detector="int8"` choice; the default detector stays the float one.
 
 A first detector candidate (not shipped: the tracker found 68 % of frames against 98 %)
 was `--detector --format qoperator --float-depthwise` with min-max calibration
