@@ -1,6 +1,6 @@
 """What the stage around the landmark model costs right after a model run, and warm.
 
-Issue 21. Inside the pipeline the Python and numpy steps around the landmark model take
+Inside the pipeline the Python and numpy steps around the landmark model take
 about three times what they take in a loop of their own: an onnxruntime run leaves every
 code path cold, so the first numpy call after it and each call of a kind not yet run this
 frame cost far more than the same call run again. This times, in one process and
@@ -12,7 +12,7 @@ into the buffers the landmark model keeps (monopic.pose.warp.WarpBuffers), and t
 with the frame widened only around the crop, as the tracker does while it tracks
 (monopic.pose.warp.WideFrame).
 
-    .venv/bin/python bench/cold_paths.py [--rounds 300] [--threads 1] [--no-append]
+    .venv/bin/python -m bench.cold_paths [--rounds 300] [--threads 1] [--no-append]
 """
 
 from __future__ import annotations
@@ -20,21 +20,18 @@ from __future__ import annotations
 import argparse
 import itertools
 import os
-import sys
 import time
 from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from history import Recorder  # noqa: E402
-
-from monopic.pose.landmarks import INPUT_SIZE, LandmarkModel, refine_from_heatmap  # noqa: E402
-from monopic.pose.region import Region  # noqa: E402
-from monopic.pose.sessions import quantised_unavailable  # noqa: E402
-from monopic.pose.warp import WarpBuffers, WideFrame, four_channel  # noqa: E402
-from monopic.video import VideoSource  # noqa: E402
+from bench.recorder import Recorder
+from monopic.pose.landmarks import INPUT_SIZE, LandmarkModel, refine_from_heatmap
+from monopic.pose.region import Region
+from monopic.pose.sessions import quantised_unavailable
+from monopic.pose.warp import WarpBuffers, WideFrame, four_channel
+from monopic.video import VideoSource
 
 TITLE = "The steps around the landmark model: right after a model run against warm"
 CLIP = Path(__file__).resolve().parents[1] / "tests" / "data" / "walk_clip.mp4"

@@ -11,12 +11,12 @@ error against the ground truth on the frames both found; CPU-seconds per frame a
 hour at 15 fps (process CPU time of the timed pass: the energy proxy). The results go to
 bench/history.jsonl as one line (bench/history.py) unless --no-append.
 
-    .venv/bin/python bench/compare_reference.py [--rounds 2] [--threads 1 2] [--no-append]
+    .venv/bin/python -m bench.compare_reference [--rounds 2] [--threads 1 2] [--no-append]
         [--model full|full-int8] [--detector float|int8] [--window-detector float|int8]
         [--spin] [--search tiles|whole-frame]
 
-Issue 21's goals were judged with `--rounds 5 --model full-int8 --spin --window-detector
-int8` (docs/benchmarks.md, session 20).
+The CPU-time goals are judged on the fastest choices, `--rounds 5 --model full-int8 --spin
+--window-detector int8` (`make bench` runs both; docs/benchmarks.md).
 """
 
 from __future__ import annotations
@@ -33,13 +33,13 @@ from typing import Any
 
 import numpy as np
 
+from bench.frameset import FrameSet, build, load
+from bench.goals import RATIO_GOAL
+from bench.paired import paired_median_difference
+from bench.recorder import Recorder
+from bench.reference_env import ensure
+
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-from frameset import FrameSet, build, load  # noqa: E402
-from goals import RATIO_GOAL  # noqa: E402
-from history import Recorder  # noqa: E402
-from paired import paired_median_difference  # noqa: E402
-from reference_env import ensure  # noqa: E402
 
 ROOT = HERE.parent
 OURS, REF = "ours", "reference"
@@ -73,9 +73,12 @@ class Collected:
 
 
 def worker_command(side: str, ref_python: Path) -> tuple[list[str], dict[str, str]]:
+    """A worker as a module run from the top folder (run_worker's cwd), so that the
+    reference venv, which has not installed the project, imports bench and monopic's
+    pure-Python modules from the checkout."""
     if side == OURS:
-        return [sys.executable, str(HERE / "pipeline_worker.py")], {}
-    return [str(ref_python), str(HERE / "reference_worker.py")], {"GLOG_minloglevel": "2"}
+        return [sys.executable, "-m", "bench.pipeline_worker"], {}
+    return [str(ref_python), "-m", "bench.reference_worker"], {"GLOG_minloglevel": "2"}
 
 
 def run_worker(

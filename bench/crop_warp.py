@@ -6,26 +6,21 @@ rotated crops (bench/alternate.py): the 256 px landmark crop and the 224 px dete
 letterbox of the whole frame, each from the RGB frame and from its four-channel form,
 and the widening itself; one OpenCV thread, as a sweep worker has.
 
-    .venv/bin/python bench/crop_warp.py [--rounds 6] [--no-append]
+    .venv/bin/python -m bench.crop_warp [--rounds 6] [--no-append]
 """
 
 from __future__ import annotations
 
 import argparse
 import math
-import sys
-from pathlib import Path
 
 import cv2
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-from alternate import alternated_ms  # noqa: E402
-from frameset import build, load  # noqa: E402
-from history import Recorder  # noqa: E402
-
-from monopic.pose.warp import four_channel  # noqa: E402
+from bench.alternate import alternated_ms
+from bench.frameset import build, load
+from bench.recorder import Recorder
+from monopic.pose.warp import four_channel
 
 TITLE = "The pose models' input warps: RGB frame against its four-channel form"
 CROP, LETTERBOX = 256, 224

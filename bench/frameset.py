@@ -10,11 +10,11 @@ number and timestamp per frame. A sequence is a run of consecutive frames: track
 reset at each sequence start.
 
 Other recipes (`Recipe`) build other sets the same way, each cached under its own
-digest: `LARGE` (issue 21: at least 500 frames on which an int8 landmark model must keep
-the float model's error) and `CALIBRATION` (other seeds and distances, the frames an int8
+digest: `LARGE` (at least 500 frames, on which an int8 landmark model must keep the
+float model's error) and `CALIBRATION` (other seeds and distances, the frames an int8
 model is calibrated on, so that it is never judged on them).
 
-    .venv/bin/python bench/frameset.py [--out recordings/bench/frames] [--recipe default]
+    .venv/bin/python -m bench.frameset [--out recordings/bench/frames] [--recipe default]
 """
 
 from __future__ import annotations

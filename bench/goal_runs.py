@@ -1,12 +1,12 @@
-"""Issue 21's goals over many runs of bench/compare_reference.py: mean and 95 % interval.
+"""The reference goals over many runs of bench/compare_reference.py: mean and 95 % interval.
 
 On this shared host one run's ratio moves by 15-25 % with the minute-to-minute speed
-(docs/history.md, session 19), so a goal near its bound is judged on the runs of one
+(docs/benchmarks.md), so a goal near its bound is judged on the runs of one
 setting: the mean over runs with its 95 % t-interval. A goal is met when the interval's
 upper end is within the bound; when only the mean is, it is met on the mean, within the
 noise, which does not close it.
 
-    .venv/bin/python bench/goal_runs.py [--since 2026-12-04T21:00:00Z] [--until ...]
+    .venv/bin/python -m bench.goal_runs [--since 2026-12-04T21:00:00Z] [--until ...]
         [--commit e722539] [--model full-int8] [--detector float] [--window-detector int8] [--spin]
         [--max-load 2.5] [--no-append]
 """
@@ -16,17 +16,16 @@ from __future__ import annotations
 import argparse
 import math
 import statistics
-import sys
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from goals import RATIO_GOAL, cpu_ratio, p50_ratio  # noqa: E402
-from history import HISTORY, BenchRun, Recorder, read  # noqa: E402
+from bench.goals import RATIO_GOAL, cpu_ratio, p50_ratio
+from bench.history import HISTORY, BenchRun, read
+from bench.recorder import Recorder
 
-TITLE = "Issue 21's goals over many compare_reference runs: mean and 95 % interval"
+TITLE = "The reference goals over many compare_reference runs: mean and 95 % interval"
 # Student's t 97.5 % quantiles, 1 to 30 degrees of freedom (two-sided 95 %).
 T975 = (12.706, 4.303, 3.182, 2.776, 2.571, 2.447, 2.365, 2.306, 2.262, 2.228,
         2.201, 2.179, 2.160, 2.145, 2.131, 2.120, 2.110, 2.101, 2.093, 2.086,

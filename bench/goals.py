@@ -1,10 +1,11 @@
 """The goals BENCHMARKS.md opens with, each read from the latest run of one benchmark.
 
-Issue 7's goals: the whole pipeline at most half the reference's per-frame time at the
+The goals: the whole pipeline at most half the reference's per-frame time at the
 same thread count (1 and 2), landmark error equal or better (judged by the paired 95 %
 interval of bench/paired.py), and a scenario run on one core at least as fast as real
-time at 15 fps. Issue 21 adds: at most half the reference's process CPU-seconds per frame,
-at 1 and at 2 threads, on the same frames and host. A goal reads the structured results
+time at 15 fps (with the rail target and with a human walker); and at most half the
+reference's process CPU-seconds per frame, at 1 and at 2 threads, on the same frames and
+host (the energy a robot spends on the pipeline). A goal reads the structured results
 of bench/history.jsonl, never the Markdown, so the goal table cannot drift from the
 figures below it. A later goal is one more entry in GOALS.
 """
@@ -186,12 +187,12 @@ GOALS = (
         ratio_at(2),
     ),
     Goal(
-        f"CPU-seconds per frame <= {RATIO_GOAL}x the reference's (issue 21), 1 thread",
+        f"CPU-seconds per frame <= {RATIO_GOAL}x the reference's, 1 thread",
         "compare_reference",
         cpu_ratio_at(1),
     ),
     Goal(
-        f"CPU-seconds per frame <= {RATIO_GOAL}x the reference's (issue 21), 2 threads",
+        f"CPU-seconds per frame <= {RATIO_GOAL}x the reference's, 2 threads",
         "compare_reference",
         cpu_ratio_at(2),
     ),
@@ -207,7 +208,7 @@ GOALS = (
         scenario_fps_of("rail"),
     ),
     Goal(
-        f"the same with a human walker (issue 17) at >= {REALTIME_FPS:g} fps",
+        f"the same with a human walker at >= {REALTIME_FPS:g} fps",
         "simulator",
         scenario_fps_of("human"),
     ),

@@ -3,8 +3,8 @@
 BENCHMARKS.md is rendered from this file (bench/render.py), so a figure is never copied
 by hand and every figure keeps what made it: the command line, the code digest
 (sim.runs.code_version), the git commit, the machine with its CPU's name and vector-unit
-flags (issue 21: the ratio against MediaPipe moved by 2x between hosts with and without
-AVX-512), and the load average around the run (this 2-core VM is shared).
+flags (the ratio against MediaPipe moved by 2x between hosts with and without AVX-512),
+and the load average around the run (this 2-core VM is shared).
 
 A line is a `BenchRun`. Its `results` hold the script's figures as plain JSON data; a
 key names its unit (`_ms`, `_us`, `_s`, `_px`, `_mb`, `_fps`, `_pct`, `_x` for a ratio
@@ -26,12 +26,9 @@ import json
 import math
 import os
 import platform
-import shlex
 import subprocess
-import sys
-import time
 from collections.abc import Mapping, Sequence
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from pathlib import Path
 from typing import Any
 
@@ -255,61 +252,6 @@ def load_average() -> float | None:
         return round(os.getloadavg()[0], 2)
     except OSError:
         return None
-
-
-def this_command() -> str:
-    """The command line just run, as typed from the repository root."""
-    script = Path(sys.argv[0]).resolve()
-    try:
-        shown = script.relative_to(ROOT)
-    except ValueError:
-        shown = script
-    return f".venv/bin/python {shown} {shlex.join(sys.argv[1:])}".rstrip()
-
-
-@dataclass
-class Recorder:
-    """Started when a benchmark starts, finished with its results: one history line.
-
-    Starting captures the date and the load before the work; `finish` adds the rest and
-    appends the line, so a benchmark that fails on the way writes nothing.
-    """
-
-    benchmark: str
-    title: str
-    history: Path = HISTORY
-    rendered: Path = BENCHMARKS
-    date: str = field(default_factory=utc_now)
-    load_before: float | None = field(default_factory=load_average)
-    _t0: float = field(default_factory=time.perf_counter, init=False, repr=False)
-
-    def finish(self, results: Mapping[str, Any], table: str, *, write: bool = True) -> BenchRun:
-        """The run's record; appended to the history (and BENCHMARKS.md re-rendered) if `write`."""
-        from sim.runs.code_version import code_version
-
-        commit, dirty = git_state()
-        run = BenchRun(
-            benchmark=self.benchmark,
-            title=self.title,
-            date=self.date,
-            duration_s=round(time.perf_counter() - self._t0, 1),
-            command=this_command(),
-            code=code_version(),
-            commit=commit,
-            dirty=dirty,
-            machine=this_machine(),
-            load_before=self.load_before,
-            load_after=load_average(),
-            results=jsonable(results),
-            table=table.rstrip(),
-        )
-        if write:
-            append(self.history, run)
-            from render import render_file  # bench/ is on sys.path: the scripts' directory
-
-            render_file(self.history, self.rendered)
-            print(f"{self.history}: +1 line; {self.rendered} rendered", file=sys.stderr)
-        return run
 
 
 def append(path: Path, run: BenchRun) -> None:

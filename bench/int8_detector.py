@@ -1,17 +1,17 @@
 """An int8 detector against the float one: calibration windows, detection agreement, time.
 
 The search frames (four detector passes while nobody is tracked) are about a quarter of a
-scenario run's time (issue 17) and of our CPU-seconds against MediaPipe (issue 21). An int8
+scenario run's time and of our CPU-seconds against MediaPipe. An int8
 detector would make each pass cheaper; it is worth shipping only if it finds the same
 people in the same places. Three steps:
 
-    .venv/bin/python bench/int8_detector.py windows --out recordings/int8/detector_windows.npz
+    .venv/bin/python -m bench.int8_detector windows --out recordings/int8/detector_windows.npz
         the detector's letterboxed input windows (the whole frame and every tile of the
         search cascade) of the calibration frame set (bench/frameset.py CALIBRATION),
         uint8, at most 600 of them
-    .venv-models/bin/python tools/models/quantize.py --detector \
+    .venv-models/bin/python -m tools.models.quantize --detector \
         --crops recordings/int8/detector_windows.npz --out recordings/int8/pose_detection_int8.onnx
-    .venv/bin/python bench/int8_detector.py judge recordings/int8/pose_detection_int8.onnx
+    .venv/bin/python -m bench.int8_detector judge recordings/int8/pose_detection_int8.onnx
         on the large frame set (bench/frameset.py LARGE; other seeds and distances): every
         window through both detectors (who is found, and how far the int8 detection's
         keypoints move, over the float box's height), the tracker with each detector
@@ -22,7 +22,7 @@ people in the same places. Three steps:
         1 thread
 
 `judge` appends one line to bench/history.jsonl unless --no-append. Nothing is shipped by
-this script. The judged int8 detector of session 16 ships as the tracker's `detector="int8"`
+this script. The judged int8 detector ships as the tracker's `detector="int8"`
 choice (monopic/pose/models/pose_detection_int8.onnx, `make models-int8`); the default
 detector stays the float one.
 """
@@ -31,27 +31,23 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-from alternate import alternated_ms  # noqa: E402
-from frameset import CALIBRATION, LARGE, FrameSet, build, load  # noqa: E402
-from history import Recorder  # noqa: E402
-from int8_landmarks import errors, track  # noqa: E402
-from paired import paired_mean_difference  # noqa: E402
+from bench.alternate import alternated_ms
+from bench.frameset import CALIBRATION, LARGE, FrameSet, build, load
+from bench.int8_landmarks import errors, track
+from bench.paired import paired_mean_difference
+from bench.recorder import Recorder
+from monopic.pose.anchors import INPUT_SIZE
+from monopic.pose.detector import Detection, PoseDetector, letterbox
+from monopic.pose.search import Window, search_windows
+from monopic.pose.sessions import make_session
+from monopic.pose.tracker import PoseTracker, TrackerConfig
 
-from monopic.pose.anchors import INPUT_SIZE  # noqa: E402
-from monopic.pose.detector import Detection, PoseDetector, letterbox  # noqa: E402
-from monopic.pose.search import Window, search_windows  # noqa: E402
-from monopic.pose.sessions import make_session  # noqa: E402
-from monopic.pose.tracker import PoseTracker, TrackerConfig  # noqa: E402
-
-TITLE = "An int8 detector against the float one (issue 17's search frames, issue 21's CPU)"
+TITLE = "An int8 detector against the float one (the search frames' time and CPU)"
 FLOAT, INT8 = "float (shipped)", "int8 candidate"
 MAX_WINDOWS = 600
 

@@ -1,17 +1,17 @@
 """An int8 landmark model against the float one: calibration crops, landmark error, time.
 
-Issue 21: an int8 landmark model (per-channel weights, calibrated on rendered frames and
+An int8 landmark model (per-channel weights, calibrated on rendered frames and
 the shipped clip) ships only if the paired mean landmark difference, int8 minus float in
 error against the truth on the frames both found, has a 95 % upper bound within 0.3 px on
 at least 500 frames. Three steps:
 
-    .venv/bin/python bench/int8_landmarks.py crops --out recordings/int8/calibration.npz
+    .venv/bin/python -m bench.int8_landmarks crops --out recordings/int8/calibration.npz
         the float tracker over the calibration frame set (bench/frameset.py CALIBRATION:
         the clip's first 30 frames and 16 rendered clips with their own seeds); every
         landmark-model input crop it made, uint8
-    .venv-models/bin/python tools/models/quantize.py --crops recordings/int8/calibration.npz
+    .venv-models/bin/python -m tools.models.quantize --crops recordings/int8/calibration.npz
         --out recordings/int8/pose_landmark_full_int8.onnx   (onnxruntime's quantizer)
-    .venv/bin/python bench/int8_landmarks.py judge recordings/int8/pose_landmark_full_int8.onnx
+    .venv/bin/python -m bench.int8_landmarks judge recordings/int8/pose_landmark_full_int8.onnx
         the tracker with each model over the large frame set (600 frames: the clip and the
         nine cases at 3, 5 and 8 m; the clip frames used for calibration are not scored),
         the paired block-bootstrap interval of the mean difference (bench/paired.py), and
@@ -23,27 +23,23 @@ at least 500 frames. Three steps:
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-from alternate import alternated_ms  # noqa: E402
-from frameset import CALIBRATION, LARGE, FrameSet, build, load  # noqa: E402
-from history import Recorder  # noqa: E402
-from paired import paired_mean_difference, paired_median_difference  # noqa: E402
+from bench.alternate import alternated_ms
+from bench.frameset import CALIBRATION, LARGE, FrameSet, build, load
+from bench.paired import paired_mean_difference, paired_median_difference
+from bench.recorder import Recorder
+from monopic.pose.landmarks import INPUT_SIZE
+from monopic.pose.sessions import LANDMARK_MODELS, make_session, model_path
+from monopic.pose.tracker import PoseTracker, TrackerConfig
 
-from monopic.pose.landmarks import INPUT_SIZE  # noqa: E402
-from monopic.pose.sessions import LANDMARK_MODELS, make_session, model_path  # noqa: E402
-from monopic.pose.tracker import PoseTracker, TrackerConfig  # noqa: E402
-
-BOUND_PX = 0.3  # the issue's limit on the upper end of the paired interval
+BOUND_PX = 0.3  # px: the most an int8 model may add to the error, the paired interval's upper end
 MIN_FRAMES = 500
-TITLE = "An int8 landmark model against the float one (issue 21's 0.3 px bound)"
+TITLE = "An int8 landmark model against the float one (its 0.3 px bound)"
 FLOAT, INT8 = "float (shipped)", "int8 candidate"
 
 

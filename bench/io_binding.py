@@ -1,12 +1,12 @@
 """What the landmark model's I/O binding saves: a plain run against a run into kept arrays.
 
-Issue 21. `session.run` allocates the three outputs and copies each out of onnxruntime,
+`session.run` allocates the three outputs and copies each out of onnxruntime,
 the heatmap's 640 kB among them; monopic.pose.landmarks.LandmarkModel binds its input and
 outputs to arrays it keeps, so a run writes into them. This alternates the two, call by
 call, on one session (the shipped model, a crop of the shipped clip as input), with a
 numpy step between calls as the pipeline has, and checks both give the same outputs.
 
-    .venv/bin/python bench/io_binding.py [--rounds 1500] [--threads 1 2] [--model full-int8]
+    .venv/bin/python -m bench.io_binding [--rounds 1500] [--threads 1 2] [--model full-int8]
         [--no-append]
 """
 
@@ -14,19 +14,16 @@ from __future__ import annotations
 
 import argparse
 import os
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from history import Recorder  # noqa: E402
-
-from monopic.pose.landmarks import INPUT_SIZE, LandmarkModel  # noqa: E402
-from monopic.pose.region import Region  # noqa: E402
-from monopic.pose.sessions import LANDMARK_MODELS, quantised_unavailable  # noqa: E402
-from monopic.video import VideoSource  # noqa: E402
+from bench.recorder import Recorder
+from monopic.pose.landmarks import INPUT_SIZE, LandmarkModel
+from monopic.pose.region import Region
+from monopic.pose.sessions import LANDMARK_MODELS, quantised_unavailable
+from monopic.video import VideoSource
 
 TITLE = "The landmark model's I/O binding: a plain run against a run into kept arrays"
 CLIP = Path(__file__).resolve().parents[1] / "tests" / "data" / "walk_clip.mp4"

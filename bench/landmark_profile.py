@@ -1,6 +1,6 @@
 """Where the landmark model's time goes on this CPU, and how far it is from the limit.
 
-Issue 21. Four parts, all in one process so that machine load hits every figure alike:
+Four parts, all in one process so that machine load hits every figure alike:
 
 1. Multiply-accumulates per frame of each landmark model (lite, full, heavy), read from
    onnxruntime's own profile of a run with only basic graph optimisations (no fusion, no
@@ -23,7 +23,7 @@ Issue 21. Four parts, all in one process so that machine load hits every figure 
 
 Every figure is a median over rounds at the load printed with it (this VM is shared).
 
-    .venv/bin/python bench/landmark_profile.py [--threads 1 2] [--rounds 15]
+    .venv/bin/python -m bench.landmark_profile [--threads 1 2] [--rounds 15]
         [--candidate FILE.onnx ...] [--no-append]
 """
 
@@ -33,7 +33,6 @@ import argparse
 import collections
 import json
 import os
-import sys
 import tempfile
 import time
 from dataclasses import dataclass
@@ -43,11 +42,10 @@ from typing import Any
 import numpy as np
 import onnxruntime as ort
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-from history import Recorder  # noqa: E402
+from bench.recorder import Recorder
+from monopic.pose.sessions import LANDMARK_MODELS, make_session, model_path
 
-from monopic.pose.sessions import LANDMARK_MODELS, make_session, model_path  # noqa: E402
+HERE = Path(__file__).resolve().parent
 
 ROOT = HERE.parent
 DENSE = {
@@ -176,8 +174,8 @@ def variants(full: Path, threads: int, candidates: list[Path], work: Path) -> di
     """Sessions to alternate: shipped, spinning, no NCHWc, ORT format, and the candidates."""
     out: dict[str, Any] = {"shipped": make_session(full, threads, spin=False)}
     if threads > 1:
-        # Since session 17 they spin within a run only (TrackerConfig.spin); older lines
-        # of the history under "spinning intra-op threads" also spun between runs.
+        # They spin within a run only (TrackerConfig.spin); the history's older lines under
+        # "spinning intra-op threads" measured threads that also spun between runs.
         out["threads spinning within runs"] = make_session(full, threads, spin=True)
     ext = ort.SessionOptions()
     ext.intra_op_num_threads = threads

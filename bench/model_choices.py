@@ -1,4 +1,4 @@
-"""MediaPipe's three landmark models, ours and the reference's, in one table (issue 21).
+"""MediaPipe's three landmark models, ours and the reference's, in one table.
 
 For each choice (lite, full, heavy: MediaPipe's model_complexity 0, 1, 2) our pipeline
 with that landmark model (`TrackerConfig.model`, `monopic video --model`) and MediaPipe
@@ -8,7 +8,7 @@ per frame (p50 on the frames both found), process CPU time per frame, the share 
 each finds, and the landmark error against the truth on the frames both found, with the
 paired 95 % interval of ours - reference (bench/paired.py).
 
-    .venv/bin/python bench/model_choices.py [--rounds 2] [--threads 1] [--no-append]
+    .venv/bin/python -m bench.model_choices [--rounds 2] [--threads 1] [--no-append]
 """
 
 from __future__ import annotations
@@ -17,14 +17,11 @@ import argparse
 import os
 import sys
 import time
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-from compare_reference import (  # noqa: E402
+from bench.compare_reference import (
     OURS,
     REF,
     Collected,
@@ -34,13 +31,12 @@ from compare_reference import (  # noqa: E402
     pooled_median,
     run_worker,
 )
-from frameset import build, load  # noqa: E402
-from history import Recorder  # noqa: E402
-from landmark_profile import macs_per_frame  # noqa: E402
-from paired import paired_median_difference  # noqa: E402
-from reference_env import ensure  # noqa: E402
-
-from monopic.pose.sessions import LANDMARK_MODELS, model_path  # noqa: E402
+from bench.frameset import build, load
+from bench.landmark_profile import macs_per_frame
+from bench.paired import paired_median_difference
+from bench.recorder import Recorder
+from bench.reference_env import ensure
+from monopic.pose.sessions import LANDMARK_MODELS, model_path
 
 MODELS = ("lite", "full", "heavy")
 TITLE = "Landmark model choices (lite, full, heavy): ours and the reference"

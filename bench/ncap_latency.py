@@ -12,7 +12,7 @@ in each run's outcome). Prints p50/p95/p99 and the figure to declare, and append
 with the machine, its CPU flags and the load average to bench/history.jsonl
 (bench/history.py) unless --no-append.
 
-    .venv/bin/python bench/ncap_latency.py [--seeds N] [--workers N] [--no-append]
+    .venv/bin/python -m bench.ncap_latency [--seeds N] [--workers N] [--no-append]
 """
 
 from __future__ import annotations
@@ -27,9 +27,9 @@ from typing import Any
 
 import numpy as np
 
+from bench.recorder import Recorder
+
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-from history import Recorder  # noqa: E402
 
 TITLE = "Pipeline latency per frame on the Euro NCAP quick grid (the declared latency's source)"
 ROUND_TO_MS = 5.0  # the declared figure: p95 rounded up to this step

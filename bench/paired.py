@@ -6,7 +6,7 @@ same frames for both sides. Errors on neighbouring frames of one walk are not in
 one sequence, not a frame or a landmark: resampling landmarks would call 0.1 px
 "significant" on a 60-frame clip. The statistic is the difference of the medians over
 landmark instances, the number the error table shows, or of the means
-(`paired_mean_difference`: issue 21's bound on what an int8 model may cost).
+(`paired_mean_difference`: the bound on what an int8 model may cost).
 """
 
 from __future__ import annotations

@@ -4,25 +4,22 @@ Runs alternate between thread counts (A B A B ...) so machine noise hits both al
 first pass over the clip of each is warm-up and not timed. Prints p50/p95 per stage and
 appends them to bench/history.jsonl (bench/history.py) unless --no-append.
 
-    .venv/bin/python bench/pipeline_latency.py [VIDEO] [--rounds 3] [--no-append]
+    .venv/bin/python -m bench.pipeline_latency [VIDEO] [--rounds 3] [--no-append]
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from bench.recorder import Recorder
 from monopic.pipeline import Pipeline, PipelineConfig
 from monopic.pose.tracker import TrackerConfig
 from monopic.video import VideoSource
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from history import Recorder  # noqa: E402
 
 STAGES = ("detect", "landmarks", "pose", "features", "predict", "warning", "total")
 # The tracker detects only when it (re)acquires; this row times one whole-frame detector

@@ -6,7 +6,7 @@ is also confined to that many cores, as the reference is. The landmark stage is 
 as shipped: the pruned landmark model and MediaPipe's heatmap refinement
 (monopic.pose.landmarks.refine_from_heatmap), as in the reference graph.
 
-    .venv/bin/python bench/pipeline_worker.py --frames recordings/bench/frames-*.npy --threads 1
+    .venv/bin/python -m bench.pipeline_worker --frames recordings/bench/frames-*.npy --threads 1
         [--model lite|full|heavy|full-int8] [--detector float|int8]
         [--window-detector float|int8] [--runtime cpu|openvino]
         [--spin] [--search tiles|whole-frame]
@@ -15,14 +15,11 @@ as shipped: the pruned landmark model and MediaPipe's heatmap refinement
 from __future__ import annotations
 
 import argparse
-import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from worker_common import run, worker_args  # noqa: E402
+from bench.worker_common import run, worker_args
 
 POST_STAGES = ("features", "predict", "warning")
 

@@ -13,13 +13,12 @@ With --intent-tree FILE (a ground intent tree, `monopic tree train --mode ground
 runner set is timed again with that tree added, as a sweep spec's `intent_tree` runs it,
 and the tree's operation counts (worst case and mean over the recorded frames) are added.
 
-    .venv/bin/python bench/post_pose.py [--repeats 30] [--intent-tree FILE] [--no-append]
+    .venv/bin/python -m bench.post_pose [--repeats 30] [--intent-tree FILE] [--no-append]
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
 import time
 from dataclasses import asdict
 from pathlib import Path
@@ -27,6 +26,8 @@ from typing import Any
 
 import numpy as np
 
+from bench.frameset import build, load
+from bench.recorder import Recorder
 from monopic.features.extractor import FeatureExtractor
 from monopic.frame import EgoState
 from monopic.pose.tracker import PoseTracker, TrackerConfig
@@ -43,10 +44,6 @@ from monopic.tree.opcount import (
 from monopic.variants.path import project_path
 from monopic.variants.warning import CollisionWarning
 from sim.scenario.spec import CameraSpec
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from frameset import build, load  # noqa: E402
-from history import Recorder  # noqa: E402
 
 PAPER_TREE_MS = 8.0
 HORIZON = 1.0

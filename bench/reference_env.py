@@ -11,7 +11,7 @@ time, from the same registry package `make models` converts ours from (Google's 
 package @mediapipe/pose, fetched with `npm pack`, sha256-checked), so the reference never
 downloads anything while it runs.
 
-    python3.11 bench/reference_env.py [--python python3.11] [--venv .venv-reference]
+    python3.11 -m bench.reference_env [--python python3.11] [--venv .venv-reference]
 """
 
 from __future__ import annotations

@@ -18,23 +18,18 @@ stays at its default: XNNPACK runs the whole model, and a second spinning pool o
 burnt CPU in a trial (2 threads: 600 ms CPU per frame under load). With --pin the
 process is also confined to that many cores, like our worker.
 
-    .venv-reference/bin/python bench/reference_worker.py --frames FRAMES.npy --threads 1
+    .venv-reference/bin/python -m bench.reference_worker --frames FRAMES.npy --threads 1
 """
 
 from __future__ import annotations
 
 import argparse
-import sys
 import time
-from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(1, str(HERE.parent))  # monopic's pure-Python modules only
-from worker_common import run, worker_args  # noqa: E402
+from bench.worker_common import run, worker_args
 
 MIN_FOOT_VISIBILITY = 0.5  # as monopic.features.extractor
 COMPLEXITY = {"lite": 0, "full": 1, "heavy": 2}  # MediaPipe's model_complexity

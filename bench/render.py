@@ -2,25 +2,25 @@
 
 The file is rewritten whole from bench/history.jsonl, never appended to: first where each
 goal stands (bench/goals.py, read from the latest runs), then the ratio against the
-reference per host (issue 21: a ratio holds for the CPU it was measured on), then the
+reference per host (a ratio holds for the CPU it was measured on), then the
 latest result of each benchmark with its command, date, machine, CPU flags, load and code
 digest, then an index of every run in the history. Nothing in it depends on when or
 where it is rendered: the same history gives the same file, byte for byte.
 
-    .venv/bin/python bench/render.py [--history bench/history.jsonl] [--out BENCHMARKS.md]
+    .venv/bin/python -m bench.render [--history bench/history.jsonl] [--out BENCHMARKS.md]
         [--check]
 """
 
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from collections.abc import Sequence
 from pathlib import Path
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from goals import GOALS, cpu_ratio, landmark_error, ratio_at  # noqa: E402
-from history import BENCHMARKS, HISTORY, ROOT, BenchRun, Machine, read  # noqa: E402
+from bench.goals import GOALS, cpu_ratio, landmark_error, ratio_at
+from bench.history import BENCHMARKS, HISTORY, ROOT, BenchRun, Machine, read
 
 NARRATIVE = "docs/benchmarks.md"
 # Sections in this order; benchmarks not listed follow by name.
@@ -158,6 +158,13 @@ def host_table(runs: Sequence[BenchRun]) -> list[str]:
     return lines + [row for _, row in sorted(rows, reverse=True)]
 
 
+def runnable(command: str) -> str:
+    """A stored command as it runs today: lines written while the benchmarks ran as scripts
+    (`python -m bench.x`) name the script's path; they run now as modules of the bench
+    package (`python -m bench.x`). The history keeps what was typed."""
+    return re.sub(r"^(\S*python) bench/(\w+)\.py\b", r"\1 -m bench.\2", command)
+
+
 def section(run: BenchRun, count: int, first: BenchRun) -> list[str]:
     m = run.machine
     flags = " ".join(m.cpu_flags) or "none of the tracked vector flags"
@@ -169,7 +176,7 @@ def section(run: BenchRun, count: int, first: BenchRun) -> list[str]:
     return [
         f"### {run.title}",
         "",
-        f"`{run.command}`",
+        f"`{runnable(run.command)}`",
         "",
         f"- run: {when(run)}, {run.duration_s:.0f} s; load average {load_text(run)}",
         f"- machine: {m.label()} ({m.cpu_allowed} allowed){', virtual' if m.virtual else ''}; "
@@ -274,7 +281,10 @@ def main() -> None:
     if args.check:
         text = render(read(args.history), args.history)
         if not args.out.exists() or args.out.read_text(encoding="utf-8") != text:
-            sys.exit(f"{args.out} is not rendered from {args.history}: run bench/render.py")
+            sys.exit(
+                f"{args.out} is not rendered from {args.history}: "
+                "run .venv/bin/python -m bench.render"
+            )
         return
     render_file(args.history, args.out)
     print(f"{args.out}: rendered from {args.history}")

@@ -6,7 +6,7 @@ two runs one after the other say little: here two processes, one per checkout, e
 a world at the same frame and render it in turns (A B, then B A), pinned to the same
 core with the sweep workers' environment, and each pair gives one ratio.
 
-    .venv/bin/python bench/render_ab.py [--before HEAD] [--renders 200] [--no-append]
+    .venv/bin/python -m bench.render_ab [--before HEAD] [--renders 200] [--no-append]
 
 `--before` is any git revision; its tree is checked out in a temporary worktree.
 """
@@ -14,6 +14,7 @@ core with the sweep workers' environment, and each pair gives one ratio.
 from __future__ import annotations
 
 import argparse
+import inspect
 import os
 import subprocess
 import sys
@@ -22,10 +23,10 @@ from pathlib import Path
 
 import numpy as np
 
+from bench.recorder import Recorder
+
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
-sys.path.insert(0, str(HERE))
-from history import Recorder  # noqa: E402
 
 TITLE = "Render time, this checkout against another commit, paired frame by frame"
 # (scenario file, frame rendered): a small-scale case, a car-scale family, a near miss.
@@ -37,15 +38,18 @@ SCENES = (
 CORE = 1
 
 
-def serve(root: str, scenario: str, frame: int) -> None:
-    """Child: render `scenario` at `frame` from checkout `root` once per line on stdin."""
+def serve(scenario: str, frame: int) -> None:
+    """Child: render `scenario` at `frame` once per line on stdin. Run with its checkout as
+    the working folder (`python -c`, whose import path starts there), so that the `sim`
+    it imports is that checkout's."""
+    import sys
     import time
+    from pathlib import Path
 
-    sys.path.insert(0, root)
     from sim.scenario.files import load
     from sim.world.world import World
 
-    with World(load(Path(root) / scenario).base) as world:
+    with World(load(Path(scenario)).base) as world:
         world.reset()
         for _ in range(frame):
             world.step()
@@ -62,23 +66,25 @@ def paired(roots: tuple[str, str], scenario: str, frame: int, renders: int) -> n
     from sim.runs.executors import WORKER_ENV
 
     env = dict(os.environ, **WORKER_ENV)
-    cmd = [sys.executable, __file__, "--serve"]
+    env.pop("PYTHONPATH", None)  # the working folder decides which checkout is imported
+    code = f"{inspect.getsource(serve)}\nserve({scenario!r}, {frame})\n"
     procs = [
         subprocess.Popen(
-            [*cmd, root, scenario, str(frame)],
+            [sys.executable, "-c", code],
             stdin=subprocess.PIPE,
             stdout=subprocess.PIPE,
             text=True,
             env=env,
+            cwd=root,
             preexec_fn=lambda: os.sched_setaffinity(0, {CORE}),
         )
         for root in roots
     ]
     try:
-        for p in procs:
+        for p, root in zip(procs, roots, strict=True):
             line = p.stdout.readline().strip() if p.stdout else ""
             if line != "ready":
-                raise SystemExit(f"render_ab: {scenario} did not start in {p.args[3]}")
+                raise SystemExit(f"render_ab: {scenario} did not start in {root}")
         times = np.empty((renders, 2))
         for i in range(renders):
             for k in (0, 1) if i % 2 == 0 else (1, 0):
@@ -95,9 +101,6 @@ def paired(roots: tuple[str, str], scenario: str, frame: int, renders: int) -> n
 
 
 def main() -> int:
-    if len(sys.argv) == 5 and sys.argv[1] == "--serve":
-        serve(sys.argv[2], sys.argv[3], int(sys.argv[4]))
-        return 0
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--before", default="HEAD", help="git revision to compare against")
     parser.add_argument("--renders", type=int, default=200, help="renders per scene and side")

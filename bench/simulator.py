@@ -10,7 +10,7 @@ spawned workers (1 and 2), with the peak RSS of a worker (ru_maxrss of the
 reaped children). The results go to bench/history.jsonl (bench/history.py) unless
 --no-append.
 
-    .venv/bin/python bench/simulator.py [--frames 60] [--runs 6] [--no-append]
+    .venv/bin/python -m bench.simulator [--frames 60] [--runs 6] [--no-append]
 """
 
 from __future__ import annotations
@@ -23,12 +23,10 @@ import statistics
 import subprocess
 import sys
 import time
-from pathlib import Path
 from typing import Any
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-from history import Recorder  # noqa: E402
+from bench.history import ROOT
+from bench.recorder import Recorder
 
 REALTIME_FPS = 15.0
 CASES = (1, 2, 3, 4, 5, 6, 8)  # walking cases; still (9) has no motion to predict
@@ -147,12 +145,12 @@ def spawn_child(kind: str, pin: bool, **kw: Any) -> dict[str, Any]:
     from sim.runs.executors import WORKER_ENV
 
     env = dict(os.environ, **WORKER_ENV)
-    cmd = [sys.executable, str(Path(__file__).resolve()), "--child", kind]
+    cmd = [sys.executable, "-m", "bench.simulator", "--child", kind]
     for k, v in kw.items():
         cmd += [f"--{k}", str(v)]
     if pin:
         cmd.append("--pin")
-    proc = subprocess.run(cmd, env=env, capture_output=True, text=True, check=False)
+    proc = subprocess.run(cmd, env=env, capture_output=True, text=True, cwd=ROOT, check=False)
     if proc.returncode != 0:
         raise RuntimeError(f"{' '.join(cmd)} failed:\n{proc.stderr[-3000:]}")
     return json.loads(proc.stdout.strip().splitlines()[-1])

@@ -1,6 +1,6 @@
 """Do onnxruntime's threads pay for spinning? Each pose model at 2 threads, sleeping or spinning.
 
-Issue 21. With a multi-threaded session whose idle threads sleep (the default), every
+With a multi-threaded session whose idle threads sleep (the default), every
 operator of a run wakes them, and on the landmark model's ~160 small operators that
 costs about what the second thread saves. `TrackerConfig(spin=True)` lets them spin
 within a run and stops them when it returns (monopic.pose.sessions.make_session). This
@@ -9,7 +9,7 @@ times both settings for each shipped model, alternated round by round in one pro
 threads that spin between runs would show their cost in the CPU column. With `--busy N`,
 N busy loops run beside it (other work on the cores): where spinning costs instead.
 
-    .venv/bin/python bench/spin.py [--threads 2] [--rounds 8] [--runs 40] [--busy 0]
+    .venv/bin/python -m bench.spin [--threads 2] [--rounds 8] [--runs 40] [--busy 0]
         [--gap-ms 1.5] [--no-append]
 """
 
@@ -19,19 +19,16 @@ import argparse
 import multiprocessing as mp
 import sys
 import time
-from pathlib import Path
 
 import numpy as np
 
+from bench.recorder import Recorder
 from monopic.pose.sessions import (
     DETECTOR_MODELS,
     LANDMARK_MODELS,
     make_session,
     model_path,
 )
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from history import Recorder  # noqa: E402
 
 MODELS = {
     "full-int8 landmarks": LANDMARK_MODELS["full-int8"],

@@ -1,10 +1,10 @@
 """How long the test suite takes: the fast part (-m "not slow") and the whole suite, once each.
 
-Timed once (the issue asks for the suite's own run time, not a distribution); the
+Timed once (the suite's own run time is the figure, not a distribution); the
 pytest summary line is kept beside the time, since a failing or skipped test changes it.
 The results go to bench/history.jsonl (bench/history.py) unless --no-append.
 
-    .venv/bin/python bench/suite_time.py [--no-append]
+    .venv/bin/python -m bench.suite_time [--no-append]
 """
 
 from __future__ import annotations
@@ -16,9 +16,9 @@ import sys
 import time
 from pathlib import Path
 
+from bench.recorder import Recorder
+
 HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-from history import Recorder  # noqa: E402
 
 ROOT = HERE.parent
 SUITES = (

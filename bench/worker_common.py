@@ -21,8 +21,7 @@ from typing import Protocol
 
 import numpy as np
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from frameset import load  # noqa: E402
+from bench.frameset import load
 
 
 class Runner(Protocol):

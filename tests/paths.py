@@ -1,10 +1,7 @@
-"""Where the tests find the repository, its fixtures, scenario files, tools and shared data."""
+"""Where the tests find the repository, its fixtures, scenario files and shared data."""
 
-import importlib.util
 import os
-import sys
 from pathlib import Path
-from types import ModuleType
 
 import pytest
 
@@ -20,14 +17,3 @@ needs_authors_logs = pytest.mark.skipif(
     not (AUTHORS_LOGS / "data0.csv").is_file(),
     reason=f"the authors' logs are not at {AUTHORS_LOGS} (set MONOPIC_SHARED_DATA)",
 )
-
-
-def load_tool(name: str) -> ModuleType:
-    """tools/<name>.py as a module (the tools are scripts, not a package). It is registered
-    in sys.modules under its name because dataclasses look their module up there."""
-    spec = importlib.util.spec_from_file_location(name, ROOT / "tools" / f"{name}.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module

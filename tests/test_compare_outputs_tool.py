@@ -1,4 +1,4 @@
-"""tools/compare_outputs.py on two small `monopic ncap` output folders made by hand.
+"""tools.compare_outputs on two small `monopic ncap` output folders made by hand.
 
 The reports are written by the command's own renderer (sim.analysis.ncap_report.render),
 so the score table the tool reads back is the one `monopic ncap` writes.
@@ -17,10 +17,10 @@ from sim.analysis import ncap_report as rep
 from sim.analysis.ncap_score import CalculatorScore, LoadCaseScore
 from sim.runs.ncap_grid import DECLARED, LatencySetting
 from sim.scenario.ncap import load_car, load_protocol
-from tests.paths import ROOT, load_tool
+from tests.paths import ROOT
+from tools import compare_outputs
 
-TOOL = ROOT / "tools" / "compare_outputs.py"
-compare_outputs = load_tool("compare_outputs")
+TOOL = [sys.executable, "-m", "tools.compare_outputs"]
 PROTOCOL = load_protocol(ROOT / "scenarios" / "ncap" / "protocol.toml")
 CAR = load_car(ROOT / "scenarios" / "ncap" / "car.toml")
 LATENCY = LatencySetting(DECLARED, 465.0)
@@ -95,8 +95,8 @@ def test_runs_and_scores_that_differ_only_in_times_and_measured_latencies_are_id
     assert compare_outputs.score_table(old / "report.md")[0].startswith("| policy | CPNA |")
     assert compare_outputs.compare_ncap(old, new) == []
     done = subprocess.run(
-        [sys.executable, str(TOOL), "compare-ncap", str(old), str(new)],
-        capture_output=True, text=True, check=False,
+        [*TOOL, "compare-ncap", str(old), str(new)],
+        capture_output=True, text=True, check=False, cwd=ROOT,
     )  # fmt: skip
     assert done.returncode == 0 and "IDENTICAL" in done.stdout, done.stdout + done.stderr
 
@@ -122,8 +122,8 @@ def test_an_outcome_an_applied_latency_a_run_or_a_score_that_differs_is_named(
     problems = compare_outputs.compare_ncap(old, write(tmp_path / "score", rows(), cpna=0.1))
     assert len(problems) == 1 and problems[0].startswith("ncap/report.md score table[2]: ")
     done = subprocess.run(
-        [sys.executable, str(TOOL), "compare-ncap", str(old), str(tmp_path / "score")],
-        capture_output=True, text=True, check=False,
+        [*TOOL, "compare-ncap", str(old), str(tmp_path / "score")],
+        capture_output=True, text=True, check=False, cwd=ROOT,
     )  # fmt: skip
     assert done.returncode == 1 and "DIFFERENT: 1 difference" in done.stdout
 

@@ -9,6 +9,7 @@ that only does maths or reads files.
 from __future__ import annotations
 
 import ast
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -152,11 +153,14 @@ def import_loops(*packages: str) -> list[frozenset[str]]:
     return loops
 
 
+PACKAGES = ("monopic", "sim", "studies", "bench", "tools")  # every package of the tree
+
+
 def test_no_import_loop_inside_any_package():
-    assert sorted(map(sorted, import_loops("monopic", "sim"))) == sorted(map(sorted, KNOWN_LOOPS))
+    assert sorted(map(sorted, import_loops(*PACKAGES))) == sorted(map(sorted, KNOWN_LOOPS))
 
 
-def test_the_loop_finder_sees_a_ring(tmp_path, monkeypatch):
+def test_the_loop_finder_sees_a_ring(tmp_path):
     ring = tmp_path / "ringpkg"
     ring.mkdir()
     (ring / "__init__.py").write_text("")
@@ -164,5 +168,76 @@ def test_the_loop_finder_sees_a_ring(tmp_path, monkeypatch):
     (ring / "b.py").write_text("def f():\n    from ringpkg import c\n")
     (ring / "c.py").write_text("import ringpkg.a\n")
     (ring / "d.py").write_text("import ringpkg.a\n")
-    monkeypatch.syspath_prepend(str(tmp_path))
-    assert import_loops("ringpkg") == [frozenset({"ringpkg.a", "ringpkg.b", "ringpkg.c"})]
+    # In a child whose import path holds the ring (PYTHONPATH), not by editing ours.
+    code = (
+        "from tests.test_layers import import_loops\n"
+        "print(sorted(map(sorted, import_loops('ringpkg'))))"
+    )
+    out = subprocess.run(
+        [sys.executable, "-c", code], cwd=ROOT, capture_output=True, text=True, check=True,
+        env={**os.environ, "PYTHONPATH": str(tmp_path)},
+    )  # fmt: skip
+    assert out.stdout.strip() == str([["ringpkg.a", "ringpkg.b", "ringpkg.c"]])
+
+
+SYS_PATH_EDITS = {"insert", "append", "extend", "remove", "pop", "clear"}
+
+
+def sys_path_edits(path: Path) -> list[str]:
+    """Every place a file changes the import path: a call of sys.path's list methods, an
+    assignment to sys.path or an item of it, or pytest's monkeypatch.syspath_prepend."""
+
+    def is_sys_path(node: ast.AST) -> bool:
+        return (
+            isinstance(node, ast.Attribute)
+            and node.attr == "path"
+            and isinstance(node.value, ast.Name)
+            and node.value.id == "sys"
+        )
+
+    found: list[tuple[int, str]] = []
+    for node in ast.walk(ast.parse(path.read_text(), filename=str(path))):
+        if isinstance(node, ast.Call) and isinstance(node.func, ast.Attribute):
+            if node.func.attr in SYS_PATH_EDITS and is_sys_path(node.func.value):
+                found.append((node.lineno, f"sys.path.{node.func.attr}"))
+            elif node.func.attr == "syspath_prepend":
+                found.append((node.lineno, "syspath_prepend"))
+        targets = (
+            node.targets if isinstance(node, ast.Assign)
+            else [node.target] if isinstance(node, ast.AugAssign | ast.AnnAssign)
+            else []
+        )  # fmt: skip
+        for t in targets:
+            if is_sys_path(t) or (isinstance(t, ast.Subscript) and is_sys_path(t.value)):
+                found.append((node.lineno, "sys.path assigned"))
+    return [f"line {line}: {what}" for line, what in sorted(found)]
+
+
+def test_nothing_in_the_tree_edits_the_import_path():
+    # Scripts run as modules from the top folder (`python -m bench.spin`), which puts the
+    # top folder on the path: a neighbour is `from bench.history import ...`, never found by
+    # editing sys.path, which hides from the import contracts what a file really reads.
+    offenders = [
+        f"{path.relative_to(ROOT)}: {edit}"
+        for folder in (*PACKAGES, "tests")
+        for path in sorted((ROOT / folder).rglob("*.py"))
+        for edit in sys_path_edits(path)
+    ]
+    assert not offenders, offenders
+
+
+def test_the_path_check_sees_every_kind_of_edit(tmp_path):
+    bad = tmp_path / "bad.py"
+    bad.write_text(
+        "import sys\nsys.path.insert(0, 'x')\nsys.path.append('y')\nsys.path[:0] = ['z']\n"
+        "sys.path += ['w']\nsys.path = []\ndef t(monkeypatch):\n"
+        "    monkeypatch.syspath_prepend('v')\nprint(sys.path[0], list(sys.path))\n"
+    )
+    assert sys_path_edits(bad) == [
+        "line 2: sys.path.insert",
+        "line 3: sys.path.append",
+        "line 4: sys.path assigned",
+        "line 5: sys.path assigned",
+        "line 6: sys.path assigned",
+        "line 8: syspath_prepend",
+    ]

@@ -1,4 +1,4 @@
-"""tools/view/screenshot.py without a Vulkan driver: one line naming the package, no viewer."""
+"""tools.view.screenshot without a Vulkan driver: one line naming the package, no viewer."""
 
 from __future__ import annotations
 
@@ -8,14 +8,15 @@ import sys
 from pathlib import Path
 
 from tests.paths import ROOT
+from tools.view import screenshot
 
-TOOL = ROOT / "tools" / "view" / "screenshot.py"
+TOOL = [sys.executable, "-m", "tools.view.screenshot"]
 
 
 def run_tool(tmp_path: Path, *args: str, env: dict[str, str]) -> subprocess.CompletedProcess:
     return subprocess.run(
-        [sys.executable, str(TOOL), *args, "--out", str(tmp_path / "shots")],
-        capture_output=True, text=True, timeout=60, env={**os.environ, **env}, cwd=tmp_path,
+        [*TOOL, *args, "--out", str(tmp_path / "shots")],
+        capture_output=True, text=True, timeout=60, env={**os.environ, **env}, cwd=ROOT,
     )  # fmt: skip
 
 
@@ -37,11 +38,6 @@ def test_a_missing_recording_is_one_line(tmp_path: Path) -> None:
 
 
 def test_the_drivers_are_found_where_the_vulkan_loader_looks(tmp_path: Path) -> None:
-    sys.path.insert(0, str(TOOL.parent))
-    try:
-        import screenshot
-    finally:
-        sys.path.remove(str(TOOL.parent))
     icd = tmp_path / "lvp_icd.json"
     icd.write_text("{}")
     listed = os.pathsep.join([str(icd), str(tmp_path / "gone.json")])

@@ -1,9 +1,9 @@
 """Before/after check for restructurings: the same commands give the same outputs.
 
-    python tools/compare_outputs.py capture DIR     # run the five commands, outputs in DIR
-    python tools/compare_outputs.py compare OLD NEW  # field by field; exit 1 on a difference
-    python tools/compare_outputs.py compare OLD NEW --renamed sim.cases=sim.scenario.cases
-    python tools/compare_outputs.py compare-ncap A B  # two `monopic ncap` output folders
+    python -m tools.compare_outputs capture DIR     # run the five commands, outputs in DIR
+    python -m tools.compare_outputs compare OLD NEW  # field by field; exit 1 on a difference
+    python -m tools.compare_outputs compare OLD NEW --renamed sim.cases=sim.scenario.cases
+    python -m tools.compare_outputs compare-ncap A B  # two `monopic ncap` output folders
 
 `capture` runs, with the installed `monopic` command (so it works on any layout):
 

@@ -1,6 +1,6 @@
 """A montage of the human walker's intent cues, frame by frame, as the robot's camera sees them.
 
-    .venv/bin/python tools/cue_montage.py [--out docs/images/cues-montage.png]
+    .venv/bin/python -m tools.cue_montage [--out docs/images/cues-montage.png]
 
 Three rows, each a scenario of a family with a `human` walker and the robot standing, so
 the walker stays in view: a head check before stepping off (wait-then-cross), the head

@@ -1,6 +1,6 @@
 """Render the end-to-end test clip and its ground truth (see sim/dataset/clip.py).
 
-    .venv/bin/python tools/render_test_clip.py
+    .venv/bin/python -m tools.render_test_clip
 
 writes tests/data/walk_clip.mp4 and tests/data/walk_clip_truth.csv.
 """

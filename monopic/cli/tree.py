@@ -18,7 +18,6 @@ from monopic.errors import UserError
 from monopic.output import write_text_atomically
 from monopic.predict.base import Mode
 from monopic.replay.dataset import prepare
-from monopic.replay.intent_training import read_dataset, split_runs, train_intent_tree
 from monopic.replay.judge import (
     VELOCITY_WINDOW_S,
     candidate_grid,
@@ -35,6 +34,7 @@ from monopic.replay.training import (
 )
 from monopic.tree.discretise import AUTHORS_DEAD_ZONE
 from monopic.tree.intent import INTENT_ATTRIBUTES, IntentTreeModel
+from monopic.tree.intent_training import read_dataset, split_runs, train_intent_tree
 from monopic.tree.report import intent_summary, intent_tree_dot, summary, tree_dot
 from monopic.tree.serialise import (
     load_any_model,
@@ -367,7 +367,7 @@ def _judge(args: argparse.Namespace) -> int:
 
 
 def _sensitivity(args: argparse.Namespace) -> int:
-    from monopic.replay.intent_sensitivity import CUE_KEYS, sensitivity, write
+    from monopic.tree.intent_sensitivity import CUE_KEYS, sensitivity, write
 
     trees = {}
     for text in args.tree:

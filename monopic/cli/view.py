@@ -66,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
             f"monopic view: no display ($DISPLAY and $WAYLAND_DISPLAY are unset): run "
             f"`rerun {path}` on a machine with a display, or `rerun --serve-web {path}` here "
             f"and open the http://<this host>:9090 address it prints in a browser (screenshots "
-            f"without a display: tools/view/screenshot.py {path} --at SECONDS)",
+            f"without a display: .venv/bin/python -m tools.view.screenshot {path} --at SECONDS)",
             file=sys.stderr,
         )
         return 1

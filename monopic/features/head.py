@@ -85,7 +85,7 @@ def head_facing(
     """The head's facing from the camera (deg, 0 at it, + to the person's left), image x only.
 
     Why not depth: BlazePose's depths of points across the head follow a head turn by about
-    a fifth at every distance (tools/head_reading.py), while the image keeps it. Seen from
+    a fifth at every distance (studies/intent/head_reading.py), while the image keeps it. Seen from
     the camera, the nose sits ahead of the ears' midpoint by NOSE_AHEAD_M sin(facing) and
     the eyes lie EYE_SEPARATION_M cos(facing) apart, left minus right (the person's left
     eye is on the image right when the face is toward the camera). NaN when the nose, an

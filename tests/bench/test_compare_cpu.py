@@ -2,14 +2,9 @@
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 
-from tests.paths import ROOT
-
-sys.path.insert(0, str(ROOT / "bench"))
-from compare_reference import OURS, REF, Collected, Run, cpu_table  # noqa: E402
+from bench.compare_reference import OURS, REF, Collected, Run, cpu_table
 
 
 def run(side: str, cpu_ms: list[float], found: list[bool]) -> Run:

@@ -2,12 +2,7 @@
 
 from __future__ import annotations
 
-import sys
-
-from tests.paths import ROOT
-
-sys.path.insert(0, str(ROOT / "bench"))
-from frameset import CALIBRATION, DEFAULT, LARGE, RECIPES, spec_digest  # noqa: E402
+from bench.frameset import CALIBRATION, DEFAULT, LARGE, RECIPES, spec_digest
 
 CLIP_FRAMES = 60  # tests/data/walk_clip.mp4
 

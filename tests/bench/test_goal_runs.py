@@ -9,14 +9,12 @@ from pathlib import Path
 
 import pytest
 
+from bench.goal_runs import summarise, t975
+from bench.history import append
 from tests.bench.test_history import bench_run, comparison
 from tests.paths import ROOT
 
-sys.path.insert(0, str(ROOT / "bench"))
-from goal_runs import summarise, t975  # noqa: E402
-from history import append  # noqa: E402
-
-SCRIPT = str(ROOT / "bench" / "goal_runs.py")
+SCRIPT = ["-m", "bench.goal_runs"]
 
 
 def test_t_quantiles_come_from_the_table_and_the_expansion_joins_it() -> None:
@@ -57,8 +55,8 @@ def _history(tmp_path: Path) -> Path:
 
 
 def _run(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run([sys.executable, SCRIPT, *args, "--no-append"],
-                          capture_output=True, text=True, timeout=120)  # fmt: skip
+    return subprocess.run([sys.executable, *SCRIPT, *args, "--no-append"],
+                          capture_output=True, text=True, timeout=120, cwd=ROOT)  # fmt: skip
 
 
 def test_the_runs_of_one_setting_are_summarised_per_goal(tmp_path: Path) -> None:

@@ -7,7 +7,7 @@ the end, which read the committed history that real `make bench` runs wrote.
 from __future__ import annotations
 
 import math
-import sys
+import re
 from dataclasses import replace
 from pathlib import Path
 from typing import Any
@@ -15,24 +15,22 @@ from typing import Any
 import numpy as np
 import pytest
 
-from tests.paths import ROOT
-
-sys.path.insert(0, str(ROOT / "bench"))
-from goals import GOALS  # noqa: E402
-from history import (  # noqa: E402
+from bench.goals import GOALS
+from bench.history import (
     BENCHMARKS,
     HISTORY,
     SCHEMA,
     BenchRun,
     HistoryError,
     Machine,
-    Recorder,
     append,
     jsonable,
     parse_cpuinfo,
     read,
 )
-from render import latest, render  # noqa: E402
+from bench.recorder import Recorder, this_command
+from bench.render import latest, render, runnable
+from tests.paths import ROOT
 
 XEON = Machine(
     host="vm-a",
@@ -248,7 +246,8 @@ def test_benchmarks_md_shows_goals_latest_results_and_flags() -> None:
     assert "NEWEST COMPARISON TABLE" in latest_part and "SIMULATOR TABLE" in latest_part
     assert "OLDER COMPARISON TABLE" not in text
     assert latest_part.index("Title of compare_reference") < latest_part.index("Title of simulator")
-    assert "`.venv/bin/python bench/compare_reference.py --rounds 4`" in latest_part
+    # Stored as the script's path (how older lines name it), shown as it runs today.
+    assert "`.venv/bin/python -m bench.compare_reference --rounds 4`" in latest_part
     assert "- run: 2026-11-23 09:30 UTC, 12 s; load average 0.5 before, 1.8 after" in latest_part
     assert (
         "- CPU flags: `avx2 avx512f avx512_vnni avx512_bf16 amx_tile amx_int8` "
@@ -288,11 +287,43 @@ def test_a_finished_recorder_appends_one_line_and_renders(tmp_path: Path) -> Non
     assert len(read(history)) == 1
 
 
+def test_a_run_records_the_command_that_runs_it_again_from_the_top_folder() -> None:
+    argv = [str(ROOT / "bench" / "spin.py"), "--rounds", "2", "--gap-ms", "0.5"]
+    assert (
+        this_command(argv, "bench.spin") == ".venv/bin/python -m bench.spin --rounds 2 --gap-ms 0.5"
+    )
+    assert this_command(argv, "") == ".venv/bin/python bench/spin.py --rounds 2 --gap-ms 0.5"
+
+
+@pytest.mark.parametrize(
+    ("stored", "shown"),
+    [
+        (".venv/bin/python bench/spin.py --busy 2", ".venv/bin/python -m bench.spin --busy 2"),
+        (".venv/bin/python -m bench.spin", ".venv/bin/python -m bench.spin"),
+        (
+            ".venv/bin/python bench/post_pose.py --intent-tree monopic/tree/ground_tree.json",
+            ".venv/bin/python -m bench.post_pose --intent-tree monopic/tree/ground_tree.json",
+        ),
+    ],
+)
+def test_a_stored_script_path_is_shown_as_the_module_that_runs_today(stored: str, shown: str):
+    assert runnable(stored) == shown
+
+
+def test_every_command_benchmarks_md_shows_names_a_module_that_exists() -> None:
+    commands = re.findall(r"^`(\.venv/bin/python [^`]*)`$", BENCHMARKS.read_text(), re.M)
+    assert commands
+    for command in commands:
+        module = command.split()[2]
+        assert command.split()[1] == "-m" and module.startswith("bench."), command
+        assert (ROOT / (module.replace(".", "/") + ".py")).is_file(), command
+
+
 def test_the_committed_benchmarks_md_is_rendered_from_the_committed_history() -> None:
     expected = render(read(HISTORY), HISTORY)
     assert BENCHMARKS.read_text(encoding="utf-8") == expected, (
         "BENCHMARKS.md is not rendered from bench/history.jsonl: run "
-        ".venv/bin/python bench/render.py"
+        ".venv/bin/python -m bench.render"
     )
 
 
@@ -327,7 +358,7 @@ def test_a_goal_is_judged_on_the_latest_quiet_run_not_a_loaded_one() -> None:
 
 
 def test_a_goal_names_a_runtime_or_landmark_model_that_is_not_the_default() -> None:
-    from goals import _runtime
+    from bench.goals import _runtime
 
     assert _runtime({}) == "" and _runtime({"runtime": "cpu", "model": "full"}) == ""
     assert _runtime({"runtime": "openvino"}) == " on openvino"
@@ -349,7 +380,7 @@ def test_a_goal_names_a_runtime_or_landmark_model_that_is_not_the_default() -> N
 def test_the_cpu_goal_is_judged_on_every_frame_with_the_same_work_beside() -> None:
     """The energy proxy counts every frame (our tile search too); the frames both sides
     found are shown beside, never instead."""
-    from goals import cpu_ratio_at
+    from bench.goals import cpu_ratio_at
 
     results = comparison((6.0, 10.0), (5.0, 10.0), [])
     for row, same in zip(results["cpu"], (4.0, 10.0, 4.5, 10.0), strict=True):

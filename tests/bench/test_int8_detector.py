@@ -6,13 +6,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+from bench import int8_detector
+from monopic.pose.search import search_windows
+from monopic.pose.tracker import TrackerConfig
 from tests.paths import ROOT
-
-sys.path.insert(0, str(ROOT / "bench"))
-import int8_detector  # noqa: E402
-
-from monopic.pose.search import search_windows  # noqa: E402
-from monopic.pose.tracker import TrackerConfig  # noqa: E402
 
 
 def test_the_judged_windows_are_the_whole_frame_and_the_whole_cascade() -> None:
@@ -25,8 +22,8 @@ def test_the_judged_windows_are_the_whole_frame_and_the_whole_cascade() -> None:
 
 def test_a_missing_candidate_is_one_line(tmp_path: Path) -> None:
     r = subprocess.run(
-        [sys.executable, str(ROOT / "bench" / "int8_detector.py"), "judge", str(tmp_path / "x")],
-        capture_output=True, text=True, timeout=120,
+        [sys.executable, "-m", "bench.int8_detector", "judge", str(tmp_path / "x")],
+        capture_output=True, text=True, timeout=120, cwd=ROOT,
     )  # fmt: skip
     assert r.returncode == 1
     assert r.stderr.strip() == f"int8_detector: {tmp_path / 'x'}: no such file"

@@ -7,13 +7,13 @@ import sys
 
 from tests.paths import ROOT
 
-SCRIPT = str(ROOT / "bench" / "io_binding.py")
+SCRIPT = ["-m", "bench.io_binding"]
 
 
 def test_a_short_run_times_both_ways_at_each_thread_count() -> None:
     r = subprocess.run(
-        [sys.executable, SCRIPT, "--rounds", "3", "--threads", "1", "2", "--no-append"],
-        capture_output=True, text=True, timeout=300,
+        [sys.executable, *SCRIPT, "--rounds", "3", "--threads", "1", "2", "--no-append"],
+        capture_output=True, text=True, timeout=300, cwd=ROOT,
     )  # fmt: skip
     assert r.returncode == 0, r.stderr
     rows = [line for line in r.stdout.splitlines() if line.startswith(("| 1 |", "| 2 |"))]
@@ -22,8 +22,8 @@ def test_a_short_run_times_both_ways_at_each_thread_count() -> None:
 
 def test_zero_rounds_is_refused_in_one_line() -> None:
     r = subprocess.run(
-        [sys.executable, SCRIPT, "--rounds", "0", "--no-append"],
-        capture_output=True, text=True, timeout=120,
+        [sys.executable, *SCRIPT, "--rounds", "0", "--no-append"],
+        capture_output=True, text=True, timeout=120, cwd=ROOT,
     )  # fmt: skip
     assert r.returncode == 1
     assert (

@@ -2,14 +2,9 @@
 
 from __future__ import annotations
 
-import sys
-
 import pytest
 
-from tests.paths import ROOT
-
-sys.path.insert(0, str(ROOT / "bench"))
-from ncap_latency import declared_figure, summarise  # noqa: E402
+from bench.ncap_latency import declared_figure, summarise
 
 
 def test_the_declared_figure_is_the_p95_rounded_up_to_5_ms() -> None:

@@ -2,17 +2,12 @@
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tests.paths import ROOT  # noqa: E402
-
-sys.path.insert(0, str(ROOT / "bench"))
-from paired import blocks, paired_mean_difference, paired_median_difference  # noqa: E402
+from bench.paired import blocks, paired_mean_difference, paired_median_difference
 
 
 def errors(n: int, seed: int) -> list[np.ndarray]:

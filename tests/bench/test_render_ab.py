@@ -9,7 +9,7 @@ from tests.paths import ROOT
 
 
 def run(*args: str) -> subprocess.CompletedProcess[str]:
-    cmd = [sys.executable, str(ROOT / "bench" / "render_ab.py"), *args, "--no-append"]
+    cmd = [sys.executable, "-m", "bench.render_ab", *args, "--no-append"]
     return subprocess.run(cmd, capture_output=True, text=True, cwd=ROOT)
 
 

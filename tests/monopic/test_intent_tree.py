@@ -19,19 +19,6 @@ from monopic.errors import UserError
 from monopic.features.record import Features, GroundFeatures
 from monopic.frame import EgoState
 from monopic.predict.base import Mode
-from monopic.replay.intent_training import (
-    FEATURE_COLUMNS,
-    LabelledRow,
-    RuleOption,
-    RunCount,
-    RunRows,
-    WarningCount,
-    choose_rules,
-    count_runs,
-    read_dataset,
-    split_runs,
-    train_intent_tree,
-)
 from monopic.tree.discretise import CutPointBins, Discretiser
 from monopic.tree.id3 import DecisionTree, Node
 from monopic.tree.intent import (
@@ -43,6 +30,19 @@ from monopic.tree.intent import (
     LeafReading,
     place,
     worst_case_ops,
+)
+from monopic.tree.intent_training import (
+    FEATURE_COLUMNS,
+    LabelledRow,
+    RuleOption,
+    RunCount,
+    RunRows,
+    WarningCount,
+    choose_rules,
+    count_runs,
+    read_dataset,
+    split_runs,
+    train_intent_tree,
 )
 from monopic.tree.serialise import (
     load_default_model,
@@ -503,7 +503,7 @@ def test_rules_are_chosen_for_fewest_near_misses_at_the_recall_of_constant_veloc
 def test_sensitivity_replays_every_predictor_per_cue_value(
     dataset: Path, tmp_path: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
-    from monopic.replay.intent_sensitivity import sensitivity
+    from monopic.tree.intent_sensitivity import sensitivity
 
     folder = tmp_path / "sens"
     lead = "pedestrian.behaviour.stop_lead"

@@ -43,9 +43,8 @@ import onnxruntime as ort  # noqa: E402
 import tensorflow as tf  # noqa: E402
 import tf2onnx  # noqa: E402
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from densify import densify  # noqa: E402
-from onnx_post import (  # noqa: E402
+from tools.models.densify import densify  # noqa: E402
+from tools.models.onnx_post import (  # noqa: E402
     canonicalize,
     fold_pad_into_conv,
     keep_outputs,

@@ -9,7 +9,7 @@ fuses into one QLinearConv: the rate its VNNI / AMX kernels reach on a dense con
 Shapes are a dense layer big enough to keep the kernels busy (256 -> 256 channels at
 32x32, 604 M multiply-accumulates), the best case the landmark model's layers can reach.
 
-    .venv-models/bin/python tools/models/dense_conv.py   (run by `make models`)
+    .venv-models/bin/python -m tools.models.dense_conv   (run by `make models`)
 """
 
 from __future__ import annotations

@@ -171,7 +171,7 @@ def fold_pad_into_conv(model: onnx.ModelProto, direct: bool = False) -> int:
     `direct` also folds the Pads a Conv reads directly. The float file keeps those
     (onnxruntime fuses them at load), but a quantised graph holds each one between a
     DequantizeLinear and a QuantizeLinear, which onnxruntime leaves as three kernels on
-    the full-resolution tensor (about 1 ms a frame of the int8 landmark model, issue 21).
+    the full-resolution tensor (about 1 ms a frame of the int8 landmark model).
     """
     graph = model.graph
     inits = {i.name: i for i in graph.initializer}

@@ -1,30 +1,31 @@
 """An int8 candidate of the landmark model or the detector, for bench/int8_*.py to judge.
 
-Static quantisation with onnxruntime's quantizer (QDQ format; `--format qoperator` for
-its QLinear operators): weights int8 per output channel, activations uint8 per tensor,
-ranges calibrated on landmark-model crops of rendered frames and the shipped clip (written
-by `bench/int8_landmarks.py crops`; the detector's windows with --detector, below). The
-shipped float model stores its weights as fp16 + Cast, which the quantizer would take for
-activations; they are turned back into float32 initializers first (lossless). The result
-is NOT shipped unless the judge says it keeps the float model's landmark error (issue 21).
+Static quantisation with onnxruntime's quantizer (QDQ format; `--format qoperator` for its
+QLinear operators): weights int8 per output channel, activations uint8 per tensor, ranges
+calibrated on landmark-model crops of rendered frames and the shipped clip (written by
+`.venv/bin/python -m bench.int8_landmarks crops`; the detector's windows with --detector,
+below). The shipped float model stores its weights as fp16 + Cast, which the quantizer
+would take for activations; they are turned back into float32 initializers first
+(lossless). The result is NOT shipped unless the judge says it keeps the float model's
+landmark error.
 
-    .venv-models/bin/python tools/models/quantize.py --crops recordings/int8/calibration.npz \
+    .venv-models/bin/python -m tools.models.quantize --crops recordings/int8/calibration.npz \
         --out recordings/int8/pose_landmark_full_int8.onnx [--method minmax|percentile|entropy]
         [--deep-only PX] [--keep-outputs]
 
 --keep-outputs keeps each output's nodes back to its last convolution (on every path) in
-float (a uint8 landmark output would step by about a pixel; session 12: it did not help).
+float (a uint8 landmark output would step by about a pixel; it did not help).
 
 --deep-only PX quantizes only the convolutions whose output is at most PX pixels on a side
 (the deep, many-channel layers, where int8 kernels gain most), keeping the early
 high-resolution layers, the decoder and the heads in float.
 
-Issue 21's candidate that keeps the float model's landmark error, shipped as
-monopic/pose/models/pose_landmark_full_int8.onnx (`make models-int8`; session 15, on the
-AVX-512 VNNI EPYC; `bench/int8_landmarks.py judge ... --rounds 6`: int8 - float +0.04
-[-0.14, +0.20] px on 559 frames, passes; 0.74 of the float time at 1 thread):
+The candidate that keeps the float model's landmark error, shipped as
+monopic/pose/models/pose_landmark_full_int8.onnx (`make models-int8`; judged on the
+AVX-512 VNNI EPYC; `.venv/bin/python -m bench.int8_landmarks judge ... --rounds 6`: int8 -
+float +0.04 [-0.14, +0.20] px on 559 frames, passes; 0.74 of the float time at 1 thread):
 
-    .venv-models/bin/python tools/models/quantize.py --crops recordings/int8/calibration.npz \
+    .venv-models/bin/python -m tools.models.quantize --crops recordings/int8/calibration.npz \
         --out monopic/pose/models/pose_landmark_full_int8.onnx --method percentile \
         --equalize 1.5 --float-ends --gptq
 
@@ -41,7 +42,7 @@ already passes (+0.10 [-0.10, +0.29] px); the two options below add margin.
 --equalize MARGIN raises each channel that a Clip(0, 6) ends (its calibration maximum M)
 toward 6 / MARGIN before quantising: the producing convolution's row and bias divided by
 M * MARGIN / 6, the consuming convolution's column (or depthwise row) multiplied by it.
-Exact while the raised channel stays below 6 (session 13: +0.71 -> +0.36 px, all int8); it
+Exact while the raised channel stays below 6 (+0.71 -> +0.36 px with all int8); it
 gives the small channels of a uint8 ReLU6 tensor more of its 256 steps.
 
 --gptq re-rounds the int8 weights on the same per-channel scales (GPTQ, Frantar et al.
@@ -55,55 +56,56 @@ into those convolutions' `pads` (tools/models/onnx_post.py `fold_pad_into_conv`,
 onnxruntime does for the float model at load). Left in place, each sat between a
 DequantizeLinear and a QuantizeLinear of equal scale, three kernels over the 128 and 64 px
 tensors that onnxruntime does not fuse: the shipped model's outputs are identical without
-them, and it runs in 0.84 of the time (session 16: 7.18 against 8.59 ms at 1 thread).
+them, and it runs in 0.84 of the time (7.18 against 8.59 ms at 1 thread).
 
 Any convolution kept float whose input comes from a DequantizeLinear gets its own
 DequantizeLinear with a per-channel (equal) scale: onnxruntime's level-1
 WeightBiasQuantization transformer otherwise quantizes that convolution's float weights
-per tensor (to it DQ -> Conv -> [Clip] -> Q is a QDQ node unit), which is what put session
-12's depthwise-float model thousands of pixels off. --float-depthwise keeps the landmark
+per tensor (to it DQ -> Conv -> [Clip] -> Q is a QDQ node unit), which put a
+depthwise-float model thousands of pixels off. --float-depthwise keeps the landmark
 model's depthwise convolutions float that way: +0.45 [+0.19, +0.74] px and 1.12x the float
 time, no better than all int8.
 
-The detector (issue 17's search frames, issue 21's CPU-seconds), for
+The detector (its search passes take about a quarter of a scenario run's time), for
 bench/int8_detector.py to judge, calibrated on the letterboxed detector windows (uint8,
-scaled to [-1, 1] as the detector takes them) written by `bench/int8_detector.py windows`.
-Every option above applies to it (--equalize and --gptq run the detector's own feeds;
---keep-heads keeps only its six output convolutions float). Its windows go through the
-calibrator in chunks (`_chunk`: it keeps every tensor of every input until the end, 34 GB
-for 600 windows). For the detector --float-ends keeps the stem (three convolutions, 112 px)
-and the feature pyramid float: every node the backbone's deepest tensor does not depend on
-(the top-down path from the first Resize, its lateral projections of the 28 and 14 px
-blocks, the six heads; 23 % of the MACs, the stem 4 %). The uint8 tensors there are what
-moved the detections (800 windows of the calibration frames that the calibration did not
-use): all int8 but the output tails, the regressed keypoints moved a median 0.8-2.7 px of
-the 224 px window, and decoding float scores with int8 boxes moved the detection as much
-as all int8, int8 scores with float boxes hardly at all; the heads float, still 0.4-1.4 px
-(their inputs uint8); the heads and the top-down path float, 0.1-0.5 px.
+scaled to [-1, 1] as the detector takes them) written by `.venv/bin/python -m
+bench.int8_detector windows`. Every option above applies to it (--equalize and --gptq run
+the detector's own feeds; --keep-heads keeps only its six output convolutions float). Its
+windows go through the calibrator in chunks (`_chunk`: it keeps every tensor of every
+input until the end, 34 GB for 600 windows). For the detector --float-ends keeps the stem
+(three convolutions, 112 px) and the feature pyramid float: every node the backbone's
+deepest tensor does not depend on (the top-down path from the first Resize, its lateral
+projections of the 28 and 14 px blocks, the six heads; 23 % of the MACs, the stem 4 %).
+The uint8 tensors there are what moved the detections (800 windows of the calibration
+frames that the calibration did not use): all int8 but the output tails, the regressed
+keypoints moved a median 0.8-2.7 px of the 224 px window, and decoding float scores with
+int8 boxes moved the detection as much as all int8, int8 scores with float boxes hardly at
+all; the heads float, still 0.4-1.4 px (their inputs uint8); the heads and the top-down
+path float, 0.1-0.5 px.
 
-    .venv-models/bin/python tools/models/quantize.py --detector \
+    .venv-models/bin/python -m tools.models.quantize --detector \
         --crops recordings/int8/detector_windows.npz \
         --out monopic/pose/models/pose_detection_int8.onnx \
         --method percentile --equalize 1.5 --float-ends --gptq
 
-`bench/int8_detector.py judge ... --no-append` (600 frames x 27 windows, the AVX-512 VNNI
-EPYC, 2026-12-03, load 3 from another job, so the time ratio is the alternated one):
-tracker found 98.2 % of frames with either detector (differing on 0 frames); windows found
-by one detector only 42 float, 10 int8 (of 4635 float finds); the farthest keypoint moved
-a median 1.0 % of the float box's height (p95 3.0 %); the tracker's landmark error, int8
-detector - float, -0.02 [-0.18, +0.17] px on 559 frames; 0.69 of the float pass time at 1
-thread (9.13 vs 13.22 ms). With min-max calibration and neither --equalize nor --gptq
-(`--detector --float-ends`): 54 / 12 windows, 1.2 % (p95 3.8 %), -0.05 [-0.19, +0.09] px,
-0.66 (load 1.0). All int8 but the output tails (`--method percentile --equalize 1.5
---gptq --keep-outputs`): 9 / 352 windows, the tracker 95.0 %, 7.5 % (p95 13.6 %), +0.38
-[+0.04, +0.80] px, 0.63. The first is shipped (session 16, `make models-int8`) as
-monopic/pose/models/pose_detection_int8.onnx, the tracker's `detector="int8"` choice;
-the default detector stays the float one.
+`.venv/bin/python -m bench.int8_detector judge ... --no-append` (600 frames x 27 windows,
+the AVX-512 VNNI EPYC, 2026-12-03, load 3 from another job, so the time ratio is the
+alternated one): tracker found 98.2 % of frames with either detector (differing on 0
+frames); windows found by one detector only 42 float, 10 int8 (of 4635 float finds); the
+farthest keypoint moved a median 1.0 % of the float box's height (p95 3.0 %); the
+tracker's landmark error, int8 detector - float, -0.02 [-0.18, +0.17] px on 559 frames;
+0.69 of the float pass time at 1 thread (9.13 vs 13.22 ms). With min-max calibration and
+neither --equalize nor --gptq (`--detector --float-ends`): 54 / 12 windows, 1.2 % (p95 3.8
+%), -0.05 [-0.19, +0.09] px, 0.66 (load 1.0). All int8 but the output tails (`--method
+percentile --equalize 1.5 --gptq --keep-outputs`): 9 / 352 windows, the tracker 95.0 %,
+7.5 % (p95 13.6 %), +0.38 [+0.04, +0.80] px, 0.63. The first is shipped (`make
+models-int8`) as monopic/pose/models/pose_detection_int8.onnx, the tracker's
+`detector="int8"` choice; the default detector stays the float one.
 
-Session 9's detector (not shipped: the tracker found 68 % of frames against 98 %) was
-`--detector --format qoperator --float-depthwise` with min-max calibration (QLinearConv;
-on an AVX2 CPU without VNNI, int8 depthwise convolutions were slower than float ones);
-before session 16 --detector implied those two options.
+A first detector candidate (not shipped: the tracker found 68 % of frames against 98 %)
+was `--detector --format qoperator --float-depthwise` with min-max calibration
+(QLinearConv; on an AVX2 CPU without VNNI, int8 depthwise convolutions were slower than
+float ones).
 """
 
 from __future__ import annotations
@@ -126,8 +128,7 @@ from onnxruntime.quantization import (
     quantize_static,
 )
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from onnx_post import fold_pad_into_conv  # noqa: E402
+from tools.models.onnx_post import fold_pad_into_conv
 
 REPO = Path(__file__).resolve().parents[2]
 FLOAT_MODEL = REPO / "monopic" / "pose" / "models" / "pose_landmark_full.onnx"

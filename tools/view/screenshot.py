@@ -1,6 +1,6 @@
 """Screenshots of a .rrd recording as the real rerun viewer draws it, on a headless machine.
 
-    .venv/bin/python tools/view/screenshot.py recordings/case5.rrd --out /tmp/shots \
+    .venv/bin/python -m tools.view.screenshot recordings/case5.rrd --out /tmp/shots \
         --at 1.5 --at 2.6 --at end [--size 1600x1000] [--view NAME] [--small 1400]
 
 What works here (2 cores, no GPU, no display): the native viewer of rerun-sdk 0.41 in its

@@ -8,7 +8,7 @@ on the same pipeline features: constant velocity, and each tree given (typically
 full tree and one grown `--without phi --without phi_rate --without head_yaw`).
 
 The warning is the pipeline's ground warning (the swept footprint); runs are counted as
-the sweep's metrics count them (monopic.replay.intent_training.count_runs). The replay
+the sweep's metrics count them (monopic.tree.intent_training.count_runs). The replay
 never renders and never runs a tree on anything but the recorded features.
 """
 
@@ -24,7 +24,8 @@ import numpy as np
 
 from monopic.errors import UserError
 from monopic.output import atomic_path, write_text_atomically
-from monopic.replay.intent_training import (
+from monopic.tree.intent import IntentTreeModel
+from monopic.tree.intent_training import (
     RunCount,
     RunRows,
     WarningCount,
@@ -33,7 +34,6 @@ from monopic.replay.intent_training import (
     predicted_point,
     warned_frames,
 )
-from monopic.tree.intent import IntentTreeModel
 
 CUE_KEYS = (
     "pedestrian.behaviour.head_check_probability",

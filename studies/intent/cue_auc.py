@@ -4,21 +4,20 @@ For every feature the ground tree may read and every intent, the area under the 
 of the feature's value for rows labelled with that intent against all other rows, among
 standing walkers (ground speed below 0.3 m/s) and walking ones. 0.5 is chance; below 0.5
 means lower values go with the intent. A diagnostic beside the tree (docs/intent/
-ground-tree.md, session 9): a feature can carry the cue and still change no warning if the
-tree reads it only in small nodes.
+ground-tree.md): a feature can carry the cue and still change no warning if the tree reads
+it only in small nodes.
 
 `--decisive` keeps only the rows where a warning is decided: the walker outside the
 robot's swept band and constant velocity's point inside it (or within the zone's reach
 of it), and adds "hold" (stop or turn away against the rest), the reading the intent
 rules need there (docs/intent/ceiling.md).
 
-    .venv/bin/python tools/intent_cue_auc.py recordings/intent/train-s9 recordings/intent/train-b-s9
-        [--decisive | --by-family]
+    .venv/bin/python -m studies.intent.cue_auc recordings/intent/train-s9 \
+        recordings/intent/train-b-s9 [--decisive | --by-family]
 
 `--by-family` prints, per family, the decisive rows' medians of time into the run, speed
-and acceleration, split by whether a stop or turn away lies ahead (session 12: the
-near-miss walkers of the families' default run-up are still starting when the warning
-is decided).
+and acceleration, split by whether a stop or turn away lies ahead (are the near-miss
+walkers of the families' default run-up still starting when the warning is decided?).
 """
 
 from __future__ import annotations
@@ -33,8 +32,8 @@ from pathlib import Path
 import numpy as np
 
 from monopic.errors import UserError
-from monopic.replay.intent_training import LabelledRow, RunRows, read_dataset
 from monopic.tree.intent import INTENT_ATTRIBUTES, INTENTS, ZONE_REACH, IntentSample
+from monopic.tree.intent_training import LabelledRow, RunRows, read_dataset
 
 STANDING_M_S = 0.3
 HOLD = "hold"  # stop or turn away: what the hold-back rule needs to know
@@ -100,7 +99,7 @@ def family_medians(
     and last the speed of the Kalman track constant velocity extrapolates (m/s).
     Shows whether a walker still starting up when the warning is decided can show a
     slowing cue at all, and what the pipeline's window (centred about 0.5 s back) reads
-    of it (session 12)."""
+    of it."""
     groups: dict[tuple[str, bool], list[tuple[float, ...]]] = {}
     for run, row in decisive(runs):
         v = row.sample.values
@@ -186,7 +185,7 @@ def main() -> int:
     )
     args = ap.parse_args()
     if args.plot and not args.by_family:
-        print("intent_cue_auc: --plot draws the --by-family view; give both", file=sys.stderr)
+        print("cue_auc: --plot draws the --by-family view; give both", file=sys.stderr)
         return 2
     runs = []
     truth: dict[str, dict[float, float]] = {}
@@ -196,7 +195,7 @@ def main() -> int:
             if args.by_family:
                 truth.update({r.run: true_speeds(folder, r.run) for r in these})
         except (OSError, ValueError, UserError) as err:
-            print(f"intent_cue_auc: {err}", file=sys.stderr)
+            print(f"cue_auc: {err}", file=sys.stderr)
             return 2
         runs += these
     if args.by_family:
@@ -218,7 +217,7 @@ def main() -> int:
             try:
                 drawn = plot_runs(runs, truth, args.plot)
             except UserError as err:
-                print(f"intent_cue_auc: {err}", file=sys.stderr)
+                print(f"cue_auc: {err}", file=sys.stderr)
                 return 2
             print(f"\n{args.plot}: runs {', '.join(drawn)}")
         return 0

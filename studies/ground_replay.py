@@ -3,8 +3,10 @@
 A results line keeps, for every frame, the foot point the pipeline found and the robot's
 speed. Replaying those through a ground-motion estimator, a point predictor and the real
 collision warning (monopic's own code, as Pipeline.process calls it) asks "what would
-this method have warned?" of hundreds of runs in seconds: bench/ground_replay.py compares
-estimators this way, tools/intent_ceiling.py the intent rules given the truth's intent.
+this method have warned?" of hundreds of runs in seconds: studies.ground_motion.estimators
+compares estimators this way, studies.intent.ceiling the intent rules given the truth's
+intent, studies.intent.crossfit trees grown out of fold, studies.intent.foot_noise the foot
+point's noise. The product never replays: this lives with the studies that do.
 """
 
 from __future__ import annotations

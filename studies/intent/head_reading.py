@@ -24,7 +24,7 @@ than half its size with the right sign. The truth is the neck's yaw set on the m
 nothing of it reaches the tracker. Not a judge of the tree: a still has no motion, and a
 head check is a change over time.
 
-    MUJOCO_GL=egl .venv/bin/python tools/head_reading.py [--out docs/intent]
+    MUJOCO_GL=egl .venv/bin/python -m studies.intent.head_reading [--out docs/intent]
 
 Writes DIR/head-reading.md (the table) and DIR/head-reading.png (readings against truth,
 slope against distance), each whole or not at all. About 2.5 minutes on one core.
@@ -50,7 +50,7 @@ from monopic.pose.tracker import PoseTracker, TrackerConfig
 from sim.world.render import GLUnavailableError, SceneRenderer
 from sim.world.scene import Scene
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 DISTANCES_M = (2.0, 3.0, 4.0, 6.0, 8.0, 12.0)
 BODY_DEG = tuple(float(b) for b in range(0, 360, 30))  # 0 facing the camera, 90 profile
 HEAD_DEG = tuple(float(h) for h in range(-60, 61, 10))  # from the shoulders, + left
@@ -250,10 +250,10 @@ def main() -> int:
     print(text)
     body = (
         "# Head yaw read from BlazePose landmarks, against distance (generated)\n\n"
-        f"`MUJOCO_GL=egl .venv/bin/python tools/head_reading.py`, "
+        f"`MUJOCO_GL=egl .venv/bin/python -m studies.intent.head_reading`, "
         f"{time.strftime('%Y-%m-%d %H:%M', time.gmtime())} UTC, {len(stills)} stills "
         f"({len(BODY_DEG)} body turns x {len(HEAD_DEG)} head turns per distance). What it "
-        "measures: the docstring of tools/head_reading.py. Picture: "
+        "measures: the docstring of studies/intent/head_reading.py. Picture: "
         "[head-reading.png](head-reading.png).\n\n" + text + "\n"
     )
     plot(stills, args.out / "head-reading.png")

@@ -1,18 +1,18 @@
-"""How far the intent rules could go with a perfect intent reading (issue 19's ceiling).
+"""How far the intent rules could go with a perfect intent reading: their ceiling.
 
 The intent tree's rules move constant velocity's point: hold it back when the tree says
 stop or turn away, move it toward the robot's path when it says start crossing
-(monopic.tree.intent.place). Four sessions of trees missed issue 19's goal (near-miss
+(monopic.tree.intent.place). Trained trees missed the intent stage's goal (near-miss
 runs warned at most a third of constant velocity's, recall@1s no more than 3 points
-lower). Is the reading the limit, or the rules themselves? This replays a sweep's own
-foot points through the shipped ground track and the real warning (sim.analysis.
-ground_replay) with the rules fed the truth's intent label of each frame, which no
-pipeline has, with the truth's current velocity in place of the Kalman track's (session
-12: how much of constant velocity's near-miss warnings is its lag), and with the true
+lower: docs/intent/verdict.md). Is the reading the limit, or the rules themselves? This
+replays a sweep's own foot points through the shipped ground track and the real warning
+(studies.ground_replay) with the rules fed the truth's intent label of each frame, which
+no pipeline has, with the truth's current velocity in place of the Kalman track's (how
+much of constant velocity's near-miss warnings is its lag), and with the true
 future point itself. Nothing here is tuned or shipped: it bounds what any tree with these
 rules, or any better velocity estimate, could do on those runs.
 
-    .venv/bin/python tools/intent_ceiling.py RESULTS.jsonl [--tree monopic/tree/ground_tree.json]
+    .venv/bin/python -m studies.intent.ceiling RESULTS.jsonl [--tree monopic/tree/ground_tree.json]
         [--out docs/intent/ceiling.md]
 """
 
@@ -31,10 +31,10 @@ from monopic.output import write_text_atomically
 from monopic.predict.base import Prediction, with_ground_point
 from monopic.tree.intent import START_CROSSING, IntentRules, LeafReading, place
 from monopic.tree.serialise import load_intent_model
-from sim.analysis.ground_replay import PointRule, ReplayFrame, judge_warnings, replay
 from sim.analysis.metrics import LEAD_GOAL, RunOutcome, paired_recall
 from sim.runs.result import RunResult
 from sim.runs.results_file import read_results
+from studies.ground_replay import PointRule, ReplayFrame, judge_warnings, replay
 
 BASELINE = "constant velocity (replayed)"
 HOLDS = ("stop", "turn away")
@@ -82,7 +82,7 @@ def perfect_point(row: RunResult) -> PointRule:
 def true_velocity_point(row: RunResult) -> PointRule:
     """Constant velocity from the pipeline's own foot point with the truth's current
     velocity instead of the Kalman track's: how much of constant velocity's near-miss
-    warnings is the track's lag, not the walker's intent (session 12). The velocity is
+    warnings is the track's lag, not the walker's intent. The velocity is
     the truth's position change over the last frame plus the robot's own travel, in the
     robot's axes: exact for a robot driving straight, as in every intent family."""
     horizon, truth = row.scenario.horizon, row.truth
@@ -187,7 +187,7 @@ def main(argv: list[str] | None = None) -> int:
     families = sorted({o.family for o in methods[BASELINE]})
     lines = [
         f"{len(rows)} runs of `{args.results}`, replayed from their own foot points "
-        f"(tools/intent_ceiling.py, rules of `{args.tree}`: start speed "
+        f"(studies/intent/ceiling.py, rules of `{args.tree}`: start speed "
         f"{rules.start_speed:g} m/s). Each method beside constant velocity on the same "
         "runs; recall counts collision runs warned at least 1 s before contact.",
         "",

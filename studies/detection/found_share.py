@@ -8,18 +8,17 @@ to acquire, then landmark tracking; no ground-truth crop), one tracker per clip.
 counts as found when the tracker returns a pose whose landmark box centre lies inside
 the mannequin's true box; a pose elsewhere counts as a false find. Only frames with the
 whole body inside the image are counted. Buckets are the true apparent height (box
-height) over the frame height. Prints the tables and appends them to bench/history.jsonl
-(bench/history.py) unless --no-append.
+height) over the frame height. Prints the tables; studies/detection/README.md says where
+its answers are kept.
 
-    .venv/bin/python bench/found_share.py [--frames 12] [--distances 2.4 3 4 ...]
-        [--width 768 --height 432] [--montage recordings/found_share_cases.png] [--no-append]
+    .venv/bin/python -m studies.detection.found_share [--frames 12] [--distances 2.4 3 4 ...]
+        [--width 768 --height 432] [--montage recordings/found_share_cases.png]
 """
 
 from __future__ import annotations
 
 import argparse
 import os
-import sys
 import time
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -34,9 +33,6 @@ from sim.scenario.cases import CasePlacement
 from sim.scenario.spec import CameraSpec, RobotSpec, Scenario
 from sim.world.world import World
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from history import Recorder  # noqa: E402
-
 BUCKETS = (
     (0.0, 1 / 8),
     (1 / 8, 1 / 6),
@@ -47,7 +43,7 @@ BUCKETS = (
 )
 BUCKET_NAMES = ("<1/8", "1/8-1/6", "1/6-1/4", "1/4-1/3", "1/3-1/2", ">1/2")
 DISTANCES = (2.4, 3.0, 4.0, 5.0, 6.0, 7.5, 9.0, 11.0, 13.5)
-BAR = 0.9  # the issue's bar: found in >= 90 % of frames with the body >= 1/4 of the frame
+BAR = 0.9  # the bar: found in >= 90 % of frames with the body >= 1/4 of the frame
 
 
 @dataclass(frozen=True)
@@ -73,11 +69,6 @@ class Tally:
 
     def share(self) -> str:
         return f"{100 * self.found / self.frames:.1f} %" if self.frames else "-"
-
-    def record(self) -> dict[str, int | float | None]:
-        """The tally as a history row (share null without frames)."""
-        share = 100 * self.found / self.frames if self.frames else None
-        return {"frames": self.frames, "found": self.found, "false": self.false, "found_pct": share}
 
 
 def big_of(tallies: list[Tally]) -> Tally:
@@ -159,9 +150,7 @@ def main() -> None:
     ap.add_argument("--height", type=int, default=432)
     ap.add_argument("--montage", type=Path, default=None, help="save a mid frame of each case")
     ap.add_argument("--montage-distance", type=float, default=6.0)
-    ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
-    recorder = Recorder("found_share", "Pose found share on rendered frames (issue 4)")
     camera = CameraSpec(width=args.width, height=args.height)
 
     tracker = PoseTracker(TrackerConfig())
@@ -214,49 +203,16 @@ def main() -> None:
     ]
     for config in CONFIGS:
         tallies = by_case[config.name]
-        big = Tally()
-        for t in tallies[3:]:
-            big.frames += t.frames
-            big.found += t.found
-            big.false += t.false
-        ok = "yes" if big.frames and big.found >= BAR * big.frames else "no"
+        big = big_of(tallies)
+        ok = "yes" if meets_bar(tallies) else "no"
         cells = " | ".join(t.share() for t in tallies)
         lines.append(f"| {config.name} | {cells} | {big.share()} ({big.frames}) | {ok} |")
-    body = "\n".join(lines)
-    print(body)
-    results = {
-        "configurations": len(CONFIGS),
-        "distances_m": args.distances,
-        "frames_per_clip": args.frames,
-        "width_px": args.width,
-        "height_px": args.height,
-        "frames_counted": total,
-        "frames_cut_by_border": skipped,
-        "world_step_median_ms": float(np.median(step_ms)),
-        "bar_pct": 100 * BAR,
-        "by_height": [
-            {"apparent_height": name, **t.record()}
-            for name, t in zip(BUCKET_NAMES, by_bucket, strict=True)
-        ],
-        "by_case": [
-            {
-                "case": c.name,
-                "by_height": [
-                    {"apparent_height": name, **t.record()}
-                    for name, t in zip(BUCKET_NAMES, by_case[c.name], strict=True)
-                ],
-                "at_least_quarter": big_of(by_case[c.name]).record(),
-                "meets_bar": meets_bar(by_case[c.name]),
-            }
-            for c in CONFIGS
-        ],
-    }
+    print("\n".join(lines))
 
     if args.montage and thumbs:
         args.montage.parent.mkdir(parents=True, exist_ok=True)
         cv2.imwrite(str(args.montage), cv2.cvtColor(montage(thumbs), cv2.COLOR_RGB2BGR))
         print(f"montage of one frame per case -> {args.montage}")
-    recorder.finish(results, body, write=not args.no_append)
 
 
 def annotate(image: np.ndarray, label: str, box: tuple, result: object) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""tools/stop_timing.py: the stop detector on hand-made tracks; the report; bad input."""
+"""studies/intent/stop_timing.py: the stop detector on hand-made tracks; the report; bad input."""
 
 from __future__ import annotations
 
@@ -10,10 +10,10 @@ import numpy as np
 import pytest
 
 from sim.analysis.realism import tracks_text
-from tests.paths import ROOT, load_tool
+from studies.intent import stop_timing
+from tests.paths import ROOT
 
-TOOL = ROOT / "tools" / "stop_timing.py"
-stop_timing = load_tool("stop_timing")
+TOOL = [sys.executable, "-m", "studies.intent.stop_timing"]
 
 STEP = 0.4
 
@@ -101,9 +101,7 @@ def test_the_report_and_the_plot_are_written(tmp_path: Path) -> None:
 
 
 def run_tool(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, str(TOOL), *args], capture_output=True, text=True, timeout=120
-    )
+    return subprocess.run([*TOOL, *args], capture_output=True, text=True, timeout=120, cwd=ROOT)
 
 
 def test_a_missing_track_file_is_one_line(tmp_path: Path) -> None:

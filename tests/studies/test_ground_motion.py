@@ -1,16 +1,11 @@
-"""bench/ground_replay.py: the per-family table counts as the sweep's metrics do."""
+"""studies.ground_motion.estimators: the per-family table counts as the sweep's metrics do."""
 
 from __future__ import annotations
-
-import sys
 
 import numpy as np
 
 from sim.analysis.metrics import FrameCounts, RunOutcome
-from tests.paths import ROOT
-
-sys.path.insert(0, str(ROOT / "bench"))
-import ground_replay  # noqa: E402
+from studies.ground_motion import estimators
 
 
 def outcome(
@@ -34,15 +29,15 @@ def test_by_family_counts_collisions_warned_a_second_ahead_and_near_misses_warne
         outcome("kerb", "near-miss", True, True, 2.0),  # a near miss that met: a collision
         outcome("look", "collision", False, True, None),  # neither: not counted
     ]
-    j = ground_replay.Judged("x", 1.0, outs, np.zeros(1))
+    j = estimators.Judged("x", 1.0, outs, np.zeros(1))
     assert j.by_family() == {"cross": (1, 3), "kerb": (2, 3)}
 
 
 def test_the_column_noise_option_reads_px_plus_per_height_or_row() -> None:
     import pytest
 
-    assert ground_replay.column_noise("0.3+0.01") == (0.3, 0.01)
-    assert ground_replay.column_noise("row") == (None, 0.0)
+    assert estimators.column_noise("0.3+0.01") == (0.3, 0.01)
+    assert estimators.column_noise("row") == (None, 0.0)
     for bad in ("0.3", "a+b", "0+0.01", "0.3+-1"):
         with pytest.raises(SystemExit, match="--column-noise"):
-            ground_replay.column_noise(bad)
+            estimators.column_noise(bad)

@@ -1,22 +1,23 @@
-"""Could any tree on the pipeline's own features read intent on a judged draw? (issue 19)
+"""Could any tree on the pipeline's own features read intent on a judged draw?
 
-Five judged draws missed issue 19's goal the same way: the hold-back that removes near
-misses also delays real crossers' warnings. Two explanations were left standing: the
-judged roads lie outside the training ranges (the tree reads priors that do not carry
-over), or the features do not tell a walker about to stop or turn away from a crosser on
-the frames where the warning is decided, wherever the tree is trained.
+Five judged draws missed the intent stage's goal (docs/intent/verdict.md) the same way:
+the hold-back that removes near misses also delays real crossers' warnings. Two
+explanations were left standing: the judged roads lie outside the training ranges (the
+tree reads priors that do not carry over), or the features do not tell a walker about to
+stop or turn away from a crosser on the frames where the warning is decided, wherever the
+tree is trained.
 
-This separates the two. It replays a sweep's own foot points (sim.analysis.ground_replay,
-the shipped ground track and the real warning) and rebuilds, frame by frame, the intent
+This separates the two. It replays a sweep's own foot points (studies.ground_replay, the
+shipped ground track and the real warning) and rebuilds, frame by frame, the intent
 features the tree may read from what the results file keeps of the pipeline: the ground
 track and its window kinematics, the path offset and distance, phi (the file's smoothed
-phi) and its rate. Head features are not in the results file and are left out (session 9:
-the tree did not use them). The runs are split into folds by run, every family in every
-fold; for each fold a tree is grown (the project's ID3 and quantile bins, as the trainer
-grows them) on the other folds' frames, labelled with the truth's intent, and read on this
-fold's frames. The hold-back rule (monopic.tree.intent.place, no release bound) is then
-replayed with each frame's out-of-fold stop + turn-away share against a range of
-thresholds.
+phi) and its rate. Head features are not in the results file and are left out (the trees
+grown with them did not use them: docs/intent/ground-tree.md). The runs are split into
+folds by run, every family in every fold; for each fold a tree is grown (the project's ID3
+and quantile bins, as the trainer grows them) on the other folds' frames, labelled with
+the truth's intent, and read on this fold's frames. The hold-back rule
+(monopic.tree.intent.place, no release bound) is then replayed with each frame's
+out-of-fold stop + turn-away share against a range of thresholds.
 
 The trees are fitted on the very draw they are read on (other runs of it), so the figures
 are optimistic for a tree trained elsewhere: the roads, speeds and cue settings are those
@@ -34,10 +35,10 @@ from the simulator's truth (a perfect reader, with the head's true yaw), `truth-
 its motion alone, and `@S` reads the truth S seconds late, as an estimator lagging by S.
 `@-S` reads it S seconds early: a cue that shows the walker's motion S seconds before it
 happens, perfectly read. How far ahead would a cue have to tell, for the goal to be in
-reach? (Session 22: the simulator's body cues add nothing to the truth's own motion, so
-this asks what any cue, real or simulated, would need.)
+reach? (The simulator's body cues add nothing to the truth's own motion, so this asks
+what any cue, real or simulated, would need.)
 
-    .venv/bin/python tools/intent_crossfit.py RESULTS.jsonl [MORE.jsonl ...]
+    .venv/bin/python -m studies.intent.crossfit RESULTS.jsonl [MORE.jsonl ...]
         [--reading pipeline|pipeline-recent|pipeline-column|truth|truth-motion[@S|@-S] ...]
         [--folds 5] [--depth 4 6]
         [--min-rows 50] [--out docs/intent/crossfit.md] [--plot docs/images/crossfit.png]
@@ -67,29 +68,29 @@ from monopic.features.window import Kinematics, SlidingWindow, angle_rate
 from monopic.frame import EgoState
 from monopic.output import atomic_path, write_text_atomically
 from monopic.predict.base import Prediction, with_ground_point
-from monopic.replay.intent_training import quantile_cuts
 from monopic.tree.discretise import CutPointBins, Discretiser
 from monopic.tree.id3 import DecisionTree, ID3Params, fit_id3
 from monopic.tree.intent import INTENT_ATTRIBUTES, IntentRules, LeafReading, place
-from sim.analysis.ground_replay import (
+from monopic.tree.intent_training import quantile_cuts
+from sim.analysis.metrics import LEAD_GOAL, PairedRecall, RunOutcome, paired_recall
+from sim.runs.result import MAIN, RunResult
+from sim.runs.results_file import read_results
+from studies.ground_replay import (
     PointRule,
     ReplayFrame,
     camera,
     judge_warnings,
     replay,
 )
-from sim.analysis.metrics import LEAD_GOAL, PairedRecall, RunOutcome, paired_recall
-from sim.runs.result import MAIN, RunResult
-from sim.runs.results_file import read_results
 
 # The ground tree's attributes less the head's reading, which the results file does not keep.
 ATTRIBUTES = tuple(a for a in INTENT_ATTRIBUTES if a not in ("head_yaw", "head_toward"))
 # The truth's reading adds the head's true yaw from the shoulders (the pipeline's own
-# reading of it is not in the results file, and reads a fifth of a turn: session 9).
+# reading of it is not in the results file, and reads a fifth of a turn: head-reading.md).
 TRUTH_ATTRIBUTES = (*ATTRIBUTES, "head_yaw")
 # s: the truth's acceleration, heading and facing rates, from the last frame this far back
-# (`delayed`: 3 frames at 15 fps; until session 15 a plain float comparison took 4 on 41 %
-# of frames)
+# (`delayed`: 3 frames at 15 fps, compared with a tolerance: a plain float comparison
+# takes 4 on 41 % of frames)
 TRUTH_WINDOW = 0.2
 RECENT_WINDOW = 0.4  # s: the `pipeline-recent` reading's line fit (about 0.2 s of lag)
 # The `pipeline-column` reading's track: the column's pixel noise as measured on the
@@ -512,7 +513,7 @@ def main(argv: list[str] | None = None) -> int:
         f"{len(rows)} runs of {names} ({counts}), {args.folds} folds by run, every family in "
         f"every fold; trees on q{args.bins} bins, the rule reading the deepest node of at "
         f"least {args.min_rows} rows, hold-back without a release bound "
-        "(tools/intent_crossfit.py). Recall: collision runs warned at least "
+        "(studies/intent/crossfit.py). Recall: collision runs warned at least "
         f"{LEAD_GOAL:g} s before contact, paired against constant velocity on the same runs.",
         "",
     ]

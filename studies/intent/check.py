@@ -1,7 +1,7 @@
 """Small checks of the intent features and labels on a few simulated runs (docs/intent).
 
-    .venv/bin/python tools/intent_check.py labels [FAMILY ...]
-    .venv/bin/python tools/intent_check.py features [--case 6] [--robot-speed 0]
+    .venv/bin/python -m studies.intent.check labels [FAMILY ...]
+    .venv/bin/python -m studies.intent.check features [--case 6] [--robot-speed 0]
 
 `labels`: the intent label sequence of shipped small-robot family files, rail target and
 human walker, from the truth alone (no rendering: a second or two per run).
@@ -29,7 +29,7 @@ from sim.scenario.files import load
 from sim.scenario.spec import Behaviour
 from sim.world.world import World
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 FAMILIES = ROOT / "scenarios" / "families" / "small"
 DEFAULT_FAMILIES = (
     "cpna25", "nearmiss_kerb_stop", "nearmiss_turn_away", "wait_then_cross",

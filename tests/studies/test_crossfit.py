@@ -1,4 +1,4 @@
-"""tools/intent_crossfit.py: folds keep families whole, the truth's reading is the walker's own
+"""studies/intent/crossfit.py: folds keep families whole, the truth's reading is the walker's own
 motion, the hold-back acts on the out-of-fold share only, and bad input is one line."""
 
 from __future__ import annotations
@@ -16,11 +16,11 @@ from monopic.camera import CameraModel
 from monopic.features.record import Features, GroundFeatures
 from monopic.predict.base import Mode
 from monopic.predict.registry import make_predictor
-from sim.analysis.ground_replay import MAX_GAP, ReplayFrame
-from tests.paths import ROOT, load_tool
+from studies.ground_replay import MAX_GAP, ReplayFrame
+from studies.intent import crossfit
+from tests.paths import ROOT
 
-TOOL = ROOT / "tools" / "intent_crossfit.py"
-crossfit = load_tool("intent_crossfit")
+TOOL = [sys.executable, "-m", "studies.intent.crossfit"]
 
 CAMERA = CameraModel.from_fov(768, 432, vertical_fov_deg=65.0, mount_height=1.2, pitch_deg=5.0)
 DT = 1 / 15
@@ -205,9 +205,7 @@ def test_the_column_reading_has_its_own_track_with_the_columns_noise() -> None:
 
 
 def run_tool(*args: str) -> subprocess.CompletedProcess[str]:
-    return subprocess.run(
-        [sys.executable, str(TOOL), *args], capture_output=True, text=True, cwd=ROOT
-    )
+    return subprocess.run([*TOOL, *args], capture_output=True, text=True, cwd=ROOT)
 
 
 def test_bad_input_is_one_line(tmp_path: Path) -> None:

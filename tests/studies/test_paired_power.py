@@ -1,4 +1,4 @@
-"""tools/paired_power.py: the family size the per-family recall test needs; bad input."""
+"""studies/intent/paired_power.py: the family size the per-family recall test needs; bad input."""
 
 from __future__ import annotations
 
@@ -8,10 +8,10 @@ import sys
 import pytest
 
 from sim.analysis.metrics import paired_difference
-from tests.paths import ROOT, load_tool
+from studies.intent import paired_power
+from tests.paths import ROOT
 
-TOOL = ROOT / "tools" / "paired_power.py"
-paired_power = load_tool("paired_power")
+TOOL = [sys.executable, "-m", "studies.intent.paired_power"]
 
 
 def test_no_run_lost_in_96_still_fails_the_minus_3_bound() -> None:
@@ -51,9 +51,7 @@ def test_each_lost_run_asks_for_more_runs() -> None:
     ],
 )
 def test_bad_input_is_one_line_naming_the_option(args: list[str], named: str) -> None:
-    out = subprocess.run(
-        [sys.executable, str(TOOL), *args], capture_output=True, text=True, cwd=ROOT
-    )
+    out = subprocess.run([*TOOL, *args], capture_output=True, text=True, cwd=ROOT)
     assert out.returncode == 2
     assert named in out.stderr and "Traceback" not in out.stderr
     assert len(out.stderr.strip().splitlines()) == 1

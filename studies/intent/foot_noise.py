@@ -1,8 +1,8 @@
-"""How noisy is the pipeline's foot point, across the line of sight and along it? (issue 19)
+"""How noisy is the pipeline's foot point, across the line of sight and along it?
 
 The ground track (monopic.features.ground_track) believes each foot point as much as its
 noise model says: 1 px plus 2.5 % of the apparent height, the same for the column and
-the row, measured before the ground column came from the hips (session 13). Whether a
+the row, measured before the ground column came from the hips. Whether a
 motion reading can lag the walker by 0.2 s or less depends on the real spread, which
 this measures on a sweep's own results file, against the simulator's truth:
 
@@ -15,7 +15,7 @@ this measures on a sweep's own results file, against the simulator's truth:
 Both include the walker's own sway (the hips' column and the lowest foot's row move with
 each step), which a track must take as noise too.
 
-    .venv/bin/python tools/foot_noise.py RESULTS.jsonl [MORE.jsonl ...] [--out noise.md]
+    .venv/bin/python -m studies.intent.foot_noise RESULTS.jsonl [MORE.jsonl ...] [--out noise.md]
 """
 
 from __future__ import annotations
@@ -30,9 +30,9 @@ import numpy as np
 
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
-from sim.analysis.ground_replay import camera
 from sim.runs.result import MAIN, RunResult
 from sim.runs.results_file import read_results
+from studies.ground_replay import camera
 
 HEIGHT_BINS = (0, 30, 60, 100, 150, 250, 10_000)  # px of apparent height
 RANGE_BINS = (0.0, 4.0, 6.0, 8.0, 10.0, 14.0, 30.0)  # m from the camera
@@ -147,7 +147,7 @@ def main(argv: list[str] | None = None) -> int:
         return 1
     names = " + ".join(f"`{p}`" for p in args.results)
     text = "\n".join([
-        f"Foot points of {names} against the truth (tools/foot_noise.py): robust spread "
+        f"Foot points of {names} against the truth (studies/intent/foot_noise.py): robust spread "
         "(1.4826 x MAD).",
         "",
         "Pixels: the foot point against the truth's ground point projected into the camera.",

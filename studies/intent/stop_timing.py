@@ -13,7 +13,7 @@ aligned at standstill (t = 0 where the speed first falls under `Settings.standst
 the speed relative to the walker's cruise speed, and how long before standstill it last
 fell below 90 % and 70 % of that cruise (the slowing's onset).
 
-    .venv/bin/python tools/stop_timing.py [--real FILE...] [--walkers 40]
+    .venv/bin/python -m studies.intent.stop_timing [--real FILE...] [--walkers 40]
         [--out docs/intent/stop-timing.md] [--plot docs/images/stop-timing.png]
 
 Speeds are position differences over one step, placed at the step's middle; crossings of
@@ -43,7 +43,7 @@ from sim.analysis.realism import STEP, read_tracks
 from sim.analysis.tracks import run_track
 from sim.runs.sweep import expand_spec, load_spec
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 # Real data is read where it is kept, never copied: $MONOPIC_SHARED_DATA, else
 # ../shared/data beside the checkout (as tests/paths.py).
 SHARED_DATA = Path(os.environ.get("MONOPIC_SHARED_DATA") or ROOT.parent / "shared" / "data")
@@ -316,7 +316,7 @@ def report_text(
         "",
         f"`{command}` ({datetime.date.today().isoformat()})",
         "",
-        f"A stop event (tools/stop_timing.py, `Settings`): at least {s.moving:g} m/s for "
+        f"A stop event (studies/intent/stop_timing.py, `Settings`): at least {s.moving:g} m/s for "
         f"{s.cruise_s:g} s (the cruise window; its median is the cruise speed), then under "
         f"{s.standstill:g} m/s for at least {s.dwell_s:g} s. The cruise window is the one "
         f"of the highest median within the {s.lookback_s:g} s before standstill (going "
@@ -456,7 +456,9 @@ def main(argv: list[str] | None = None) -> int:
         results[settings] = (scenes, [*scenes, *both, *(stop_set(g, settings) for g in simulated)])
     settings = Settings()
     scenes, sets = results[settings]
-    command = shlex.join([".venv/bin/python", "tools/stop_timing.py", *(argv or sys.argv[1:])])
+    command = shlex.join(
+        [".venv/bin/python", "-m", "studies.intent.stop_timing", *(argv or sys.argv[1:])]
+    )
     for path in (args.plot, args.out):
         path.parent.mkdir(parents=True, exist_ok=True)
     link = os.path.relpath(args.plot.resolve(), args.out.resolve().parent)

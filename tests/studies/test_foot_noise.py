@@ -1,4 +1,4 @@
-"""tools/foot_noise.py: the spreads it reports are the noise put into the foot points,
+"""studies/intent/foot_noise.py: the spreads it reports are the noise put into the foot points,
 split into column and row, and across and along the line of sight; bad input is one line."""
 
 from __future__ import annotations
@@ -10,11 +10,11 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from sim.analysis.ground_replay import camera
-from tests.paths import ROOT, load_tool
+from studies.ground_replay import camera
+from studies.intent import foot_noise
+from tests.paths import ROOT
 
-TOOL = ROOT / "tools" / "foot_noise.py"
-foot_noise = load_tool("foot_noise")
+TOOL = [sys.executable, "-m", "studies.intent.foot_noise"]
 
 MAIN = foot_noise.MAIN
 
@@ -60,7 +60,7 @@ def test_noiseless_foot_points_give_no_spread() -> None:
 
 
 def test_bad_input_is_one_line(tmp_path) -> None:
-    got = subprocess.run([sys.executable, str(TOOL), str(tmp_path / "none.jsonl")],
+    got = subprocess.run([*TOOL, str(tmp_path / "none.jsonl")],
                          capture_output=True, text=True, cwd=ROOT)  # fmt: skip
     assert got.returncode == 1 and "no such results file" in got.stderr
     assert len(got.stderr.strip().splitlines()) == 1

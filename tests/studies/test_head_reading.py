@@ -1,4 +1,4 @@
-"""tools/head_reading.py: its image reading on hand-made heads, its agreement, its errors."""
+"""studies.intent.head_reading: its image reading on hand-made heads, its agreement, its errors."""
 
 from __future__ import annotations
 
@@ -11,10 +11,10 @@ import pytest
 from hypothesis import given
 from hypothesis import strategies as st
 
-from tests.paths import ROOT, load_tool
+from studies.intent import head_reading
+from tests.paths import ROOT
 
-TOOL = ROOT / "tools" / "head_reading.py"
-head_reading = load_tool("head_reading")
+TOOL = [sys.executable, "-m", "studies.intent.head_reading"]
 
 PX_PER_M = 300.0
 
@@ -82,8 +82,8 @@ def test_agreement_of_a_full_reading_a_blind_one_and_a_fifth() -> None:
 
 def test_a_missing_output_directory_is_one_line(tmp_path) -> None:
     r = subprocess.run(
-        [sys.executable, str(TOOL), "--out", str(tmp_path / "nowhere")],
-        capture_output=True, text=True, timeout=120,
+        [*TOOL, "--out", str(tmp_path / "nowhere")],
+        capture_output=True, text=True, timeout=120, cwd=ROOT,
     )  # fmt: skip
     assert r.returncode == 2 and r.stdout == ""
     assert r.stderr.strip() == f"head_reading: --out {tmp_path / 'nowhere'}: no such directory"

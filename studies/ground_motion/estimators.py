@@ -4,19 +4,23 @@ A sweep's results file keeps, for every frame, the foot point the pipeline found
 robot's speed. This replays those foot points through a ground-motion estimator, then
 through the real constant-velocity ground predictor and the real collision warning
 (monopic's own code, as Pipeline.process calls it), and judges the warnings with the
-sweep's own metrics (sim.analysis.metrics). So estimators can be compared on hundreds of runs in
-seconds. Compared: the finite differences used up to session 3 (positions in the
-odometry frame differenced over 4 frames, averaged over 4) and the shipped Kalman track
-(monopic/features/ground_track.py), plus any Kalman settings given on the command line.
+sweep's own metrics (sim.analysis.metrics). So estimators can be compared on hundreds of
+runs in seconds. Compared: finite differences, the estimator the Kalman track replaced
+(positions in the odometry frame differenced over 4 frames, averaged over 4), and the
+shipped Kalman track (monopic/features/ground_track.py), plus any Kalman settings given on
+the command line.
 
 Only constant-velocity/ground is replayed: its decision depends on nothing but the ground
 track. The agreement column says how many frames' warnings the replay reproduces from the
 file; the estimator that produced the file should agree on nearly all (foot points are
 stored to 0.1 px).
 
-    .venv/bin/python bench/ground_replay.py recordings/medium-s4.jsonl \
+    .venv/bin/python -m studies.ground_motion.estimators recordings/medium-s4.jsonl \
         [--acceleration 1.5 3] [--initial-speed 2] [--column-noise 0.3+0.01]
-        [--plot errors.png] [--no-append]
+        [--plot errors.png]
+
+Prints the table (and draws the plot); studies/ground_motion/README.md says where its
+answers are kept.
 """
 
 from __future__ import annotations
@@ -28,7 +32,6 @@ import sys
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -39,21 +42,18 @@ from monopic.features.ground_track import GroundTrackConfig
 from monopic.features.motion import VelocityEstimator
 from monopic.frame import EgoState
 from monopic.output import atomic_path
-from sim.analysis.ground_replay import Estimator, ground_errors, judge_warnings, replay
 from sim.analysis.metrics import FrameCounts, group_by, summarise
 from sim.runs.result import MAIN, RunResult
 from sim.runs.results_file import read_results
-
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from history import Recorder  # noqa: E402
+from studies.ground_replay import Estimator, ground_errors, judge_warnings, replay
 
 METHOD = "constant-velocity/ground"
-TITLE = "Ground-motion estimators replayed on a sweep's foot points"
 
 
 @dataclass
 class FiniteDifferences:
-    """The estimator up to session 3: odometry-frame positions differenced, then averaged."""
+    """The estimator before the Kalman track: odometry-frame positions differenced, then
+    averaged."""
 
     odometry: Odometry = field(default_factory=Odometry)
     velocity: VelocityEstimator = field(default_factory=lambda: VelocityEstimator(4, 4))
@@ -82,34 +82,10 @@ class Judged:
     outcomes: list
     errors: np.ndarray
 
-    def record(self) -> dict[str, Any]:
-        """The row's figures as history data (errors in metres)."""
-        sm = summarise(METHOD, self.outcomes)
-        f = sum((o.frames for o in self.outcomes), FrameCounts())
-        near = [o for o in self.outcomes if o.near_miss]
-        e = self.errors
-        return {
-            "estimator": self.name,
-            "agreement_pct": 100 * self.agreement,
-            "collision_runs": sm.collision_runs,
-            "warned_1s": sm.warned_1s,
-            "warned": sm.warned,
-            "near_misses": len(near),
-            "near_misses_warned": sum(o.warned for o in near),
-            "false_alarm_frames": f.fp,
-            "frame_precision": f.tp / max(f.tp + f.fp, 1),
-            "frame_recall": f.tp / max(f.tp + f.fn, 1),
-            "error_p50_m": float(np.percentile(e, 50)),
-            "error_p90_m": float(np.percentile(e, 90)),
-            "error_p99_m": float(np.percentile(e, 99)),
-            "error_over_10m_pct": float(100 * np.mean(e > 10)),
-            "warned_by_family": {k: list(v) for k, v in self.by_family().items()},
-        }
-
     def by_family(self) -> dict[str, tuple[int, int]]:
         """Per family: (runs warned, runs) — collision runs warned 1 s ahead, or near-miss
         runs warned at all. A near miss the track's lag causes shows in some families
-        and not others (docs/intent/ground-tree.md, session 12)."""
+        and not others (docs/intent/ground-tree.md)."""
         out: dict[str, tuple[int, int]] = {}
         for family, outs in group_by(self.outcomes, lambda o: o.family).items():
             sm = summarise(METHOD, outs)
@@ -213,13 +189,11 @@ def main() -> None:
         "apparent height); 'row' keeps the column as noisy as the row (shipped)",
     )
     ap.add_argument("--plot", type=Path, help="PNG of the error distributions")
-    ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
-    recorder = Recorder("ground_replay", TITLE)
     rows = load(args.results)
     shipped = GroundTrackConfig()
     candidates: list[tuple[str, Callable[[], Estimator]]] = [
-        ("finite differences (to session 3)", FiniteDifferences),
+        ("finite differences (before the Kalman track)", FiniteDifferences),
         ("Kalman track (shipped)", GroundMotion),
     ]
     grid = itertools.product(
@@ -273,15 +247,7 @@ def main() -> None:
     if args.plot:
         plot(judged, args.plot, f"{len(rows)} runs of {args.results.name}, {METHOD}")
         lines += ["", f"![error distributions]({args.plot})"]
-    table = "\n".join(lines)
-    print(table)
-    results = {
-        "results_file": str(args.results),
-        "runs": len(rows),
-        "method": METHOD,
-        "estimators": [j.record() for j in judged],
-    }
-    recorder.finish(results, table, write=not args.no_append)
+    print("\n".join(lines))
 
 
 if __name__ == "__main__":

@@ -1,15 +1,15 @@
 """How many collision runs a judged family needs before the recall goal can be met at all.
 
-Issue 19's per-family test asks the paired 95 % interval of the recall difference (the
-intent predictor minus constant velocity, `sim.analysis.metrics.paired_difference`) to
-have its lower bound at -3 points or better. With n collision runs and a warned share
-near constant velocity's, that bound stays below -3 points at small n even when the
-predictor loses no run at all, so a judged draw too small fails any predictor. This prints,
-for each warned share and number of runs lost (warned 1 s ahead by constant velocity
-only, none gained), the lower bound at the given family sizes and the smallest family
-size at which the bound reaches the goal.
+The intent stage's per-family test (docs/intent/verdict.md) asks the paired 95 % interval
+of the recall difference (the intent predictor minus constant velocity,
+`sim.analysis.metrics.paired_difference`) to have its lower bound at -3 points or better.
+With n collision runs and a warned share near constant velocity's, that bound stays below
+-3 points at small n even when the predictor loses no run at all, so a judged draw too
+small fails any predictor. This prints, for each warned share and number of runs lost
+(warned 1 s ahead by constant velocity only, none gained), the lower bound at the given
+family sizes and the smallest family size at which the bound reaches the goal.
 
-    .venv/bin/python tools/paired_power.py [--share 0.8 0.85 0.9 0.95] [--lost 0 1 2]
+    .venv/bin/python -m studies.intent.paired_power [--share 0.8 0.85 0.9 0.95] [--lost 0 1 2]
         [--runs 96 128 200] [--bound -3]
 """
 

@@ -1,0 +1,1 @@
+"""Which ground-motion estimator should the warning's track be? Replayed on sweeps' own runs."""

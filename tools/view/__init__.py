@@ -1,0 +1,1 @@
+"""Recordings as the real rerun viewer draws them, on a machine without a display."""
