@@ -46,7 +46,8 @@ def ranged(
         below = low is not None and (value <= low if open_low else value < low)
         above = high is not None and (value >= high if open_high else value > high)
         if not math.isfinite(value) or below or above:
-            raise argparse.ArgumentTypeError(f"must be {text}, got {value_text!r}")
+            shown = f"in {text}" if text[0] in "[(" else text
+            raise argparse.ArgumentTypeError(f"must be {shown}, got {value_text!r}")
         return value
 
     check.range_text = text  # type: ignore[attr-defined]

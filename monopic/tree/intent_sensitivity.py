@@ -1,7 +1,8 @@
 """How much the ground intent tree gains over constant velocity as each cue changes.
 
 What it answers: the gain against each cue's lead time and probability, and whether the
-gain from body features (phi, head yaw) vanishes when the walker shows no body cue. Rendering is the expensive part, so the cue settings are rendered once into a
+gain from body features (phi, head yaw) vanishes when the walker shows no body cue.
+Rendering is the expensive part, so the cue settings are rendered once into a
 dataset (`scenarios/datasets/intent-sensitivity.toml`) and every predictor is replayed
 on the same pipeline features: constant velocity, and each tree given (typically the
 full tree and one grown `--without phi --without phi_rate --without head_yaw`).

@@ -338,8 +338,10 @@ def test_import_sim_before_gymnasium_registers_nothing() -> None:
 def test_the_readme_example_runs_as_written() -> None:
     readme = (ROOT / "README.md").read_text()
     blocks = [b.split("```", 1)[0] for b in readme.split("```python\n")[1:]]
-    (example,) = [b for b in blocks if "sim.envs:monopic/PedestrianCrossing-v0" in b]
-    assert 'config={"scenario": "scenarios/' in example  # it shows a scenario file
+    # The simulated world's example, with a shipped scenario file (the README's own-file
+    # section has one of its own, run by tests/test_walkthrough.py).
+    (example,) = [b for b in blocks if 'config={"scenario": "scenarios/' in b]
+    assert "sim.envs:monopic/PedestrianCrossing-v0" in example
     code = example + "\nprint(obs.shape == env.observation_space.shape)\nenv.close()\n"
     result = subprocess.run(
         [sys.executable, "-c", code], capture_output=True, text=True, cwd=ROOT, timeout=300
