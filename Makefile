@@ -31,8 +31,9 @@ demo: $(STAMP)
 ncap: $(STAMP)
 	$(BIN)/monopic ncap --quick --out recordings/ncap-quick
 
+# The suite on every core (pytest-xdist): about 9 minutes on 2 cores, 14 on one.
 test: $(STAMP) lint
-	$(BIN)/python -m pytest -q
+	$(BIN)/python -m pytest -q -n auto
 
 lint: $(STAMP)
 	$(BIN)/ruff check .
