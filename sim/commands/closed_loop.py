@@ -12,11 +12,16 @@ from monopic.cli.args import (
     deprecated_alias,
     output_file,
     output_folder,
-    positive_int,
     ranged,
 )
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
+from sim.commands.executor_options import (
+    add_executor_options,
+    check_executor_options,
+    logs_above_the_bar,
+    make_executor,
+)
 
 if TYPE_CHECKING:  # the simulator is imported when the command runs
     from sim.scenario.spec import Scenario
@@ -95,16 +100,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         f"as <out>.jsonl; without --out {DEFAULT_RESULTS})",
     )
     p.add_argument("--rrd-dir", type=Path, help="record every braking run into this folder")
-    p.add_argument(
-        "--workers", type=positive_int, help="local worker processes (>= 1; default: all cores)"
-    )
-    p.add_argument(
-        "--executor",
-        choices=("local", "ray"),
-        default="local",
-        help="local worker processes, or Ray tasks (extra `ray`) (default %(default)s)",
-    )
-    p.add_argument("--address", help="Ray cluster address for --executor ray (e.g. host:6379)")
+    add_executor_options(p)
     p.add_argument(
         "--restart",
         action="store_true",
@@ -145,16 +141,11 @@ def results_path(args: argparse.Namespace) -> Path:
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim.commands.sweep import logs_above_the_bar
     from sim.runs import closed_loop_grid as grid
     from sim.runs.closed_loop import NO_BRAKE, check_policy, format_runs, format_table, summarise
-    from sim.runs.executors import local_executor, ray_executor
     from sim.runs.latency import FIXED, MEASURED, LatencySetting
 
-    if args.address and args.executor != "ray":
-        raise UserError("--address is for --executor ray")
-    if args.workers and args.executor == "ray":
-        raise UserError("--workers is for --executor local (Ray schedules by the cluster's CPUs)")
+    check_executor_options(args)
     speeds = None if args.robot_speeds is None else _numbers(args.robot_speeds, "--robot-speeds")
     policies = [p.strip() for p in args.policies.split(",") if p.strip()]
     if not policies:
@@ -197,10 +188,7 @@ def run(args: argparse.Namespace) -> int:
         else LatencySetting(FIXED, float(args.latency_ms))
     )
     runs = grid.expand(sources, scenarios, policies, latency, args.rrd_dir)
-    if args.executor == "ray":
-        executor = ray_executor(args.address, run=grid.work)
-    else:
-        executor = local_executor(args.workers, run=grid.work)
+    executor = make_executor(args, run=grid.work)
     with logs_above_the_bar(args.executor, args.address), _temporaries_cleared(args.rrd_dir):
         outcome = grid.run_runs(runs, results, executor)
     if outcome.failed:

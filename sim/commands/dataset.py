@@ -3,13 +3,18 @@
 from __future__ import annotations
 
 import argparse
-import os
 from pathlib import Path
 
 from tqdm import tqdm
 
-from monopic.cli.args import output_folder, positive_int
-from monopic.errors import UserError
+from monopic.cli.args import output_folder
+from sim.commands.executor_options import (
+    add_executor_options,
+    check_executor_options,
+    logs_above_the_bar,
+    make_executor,
+    workers_of,
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -40,17 +45,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="DIR",
         help="the dataset folder (made as needed; an unfinished one of the same spec resumes)",
     )
-    p.add_argument(
-        "--workers", type=positive_int, help="local worker processes (>= 1; default: all cores)"
-    )
-    p.add_argument(
-        "--executor",
-        choices=("local", "ray"),
-        default="local",
-        help="local worker processes, or Ray tasks (extra `ray`; DIR must be a folder every "
-        "node sees at the same path) (default %(default)s)",
-    )
-    p.add_argument("--address", help="Ray cluster address for --executor ray (e.g. host:6379)")
+    add_executor_options(p, "DIR must be a folder every node sees at the same path")
     p.add_argument(
         "--estimate-only", action="store_true", help="print the size and time estimate and stop"
     )
@@ -58,7 +53,6 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from sim.commands.sweep import logs_above_the_bar
     from sim.dataset.build import (
         build,
         check_folder,
@@ -68,16 +62,12 @@ def run(args: argparse.Namespace) -> int:
         work,
     )
     from sim.dataset.spec import expand, load_spec
-    from sim.runs.executors import local_executor, ray_executor
 
-    if args.address and args.executor != "ray":
-        raise UserError("--address is for --executor ray")
-    if args.workers and args.executor == "ray":
-        raise UserError("--workers is for --executor local (Ray schedules by the cluster's CPUs)")
+    check_executor_options(args)
     spec = load_spec(args.spec)
     out: Path = args.out
     # None: a Ray cluster's CPUs, unknown here (the estimate then gives CPU time).
-    workers = None if args.executor == "ray" else (args.workers or os.cpu_count() or 1)
+    workers = workers_of(args)
     check_folder(spec, out)  # the estimate refuses what the build would
     if args.estimate_only:
         runs = expand(spec)
@@ -87,10 +77,7 @@ def run(args: argparse.Namespace) -> int:
         print(f"time: {estimate_duration(todo, list(done.values()), workers).text()}")
         return 0
     output_folder(out.parent, "--out")
-    if args.executor == "ray":
-        executor = ray_executor(args.address, run=work)
-    else:
-        executor = local_executor(workers, run=work)
+    executor = make_executor(args, run=work)
     with logs_above_the_bar(args.executor, args.address):
         outcome = build(spec, out, executor, workers, report=tqdm.write)
     if outcome.counts is None:

@@ -10,6 +10,12 @@ from pathlib import Path
 from monopic.cli.args import deprecated_alias, non_negative_float, output_folder, positive_int
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
+from sim.commands.executor_options import (
+    add_executor_options,
+    check_executor_options,
+    logs_above_the_bar,
+    make_executor,
+)
 
 PROTOCOL = Path("scenarios/ncap/protocol.toml")
 CAR = Path("scenarios/ncap/car.toml")
@@ -77,16 +83,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="apply the pipeline's latency measured on this host per frame instead of the "
         "declared one (the score then moves with the host's speed and load)",
     )
-    p.add_argument(
-        "--workers", type=positive_int, help="local worker processes (>= 1; default: all cores)"
-    )
-    p.add_argument(
-        "--executor",
-        choices=("local", "ray"),
-        default="local",
-        help="local worker processes or a Ray cluster (default %(default)s)",
-    )
-    p.add_argument("--address", help="Ray cluster address (--executor ray)")
+    add_executor_options(p)
     p.add_argument("--restart", action="store_true", help="set aside other code's results")
     p.add_argument(
         "--protocol",
@@ -120,6 +117,7 @@ def run(args: argparse.Namespace) -> int:
     from sim.analysis.ncap_score import require_calculator
     from sim.scenario.ncap import load_car, load_protocol
 
+    check_executor_options(args)
     version = require_calculator()
     protocol = load_protocol(args.protocol)
     car = load_car(args.car)
@@ -163,7 +161,6 @@ def run(args: argparse.Namespace) -> int:
     from sim.analysis import ncap_report as rep
     from sim.analysis.ncap_score import score
     from sim.runs import ncap_grid
-    from sim.runs.executors import local_executor, ray_executor
 
     latency = ncap_grid.latency_setting(car, args.latency_ms, args.measured_latency)
     runs = ncap_grid.expand(
@@ -173,12 +170,10 @@ def run(args: argparse.Namespace) -> int:
     output_folder(args.out, "--out")
     results = args.out / "results.jsonl"
     ncap_grid.check_results(results, args.restart)
-    if args.executor == "ray":
-        executor = ray_executor(args.address, run=ncap_grid.work)
-    else:
-        executor = local_executor(args.workers, run=ncap_grid.work)
+    executor = make_executor(args, run=ncap_grid.work)
     t0 = time.perf_counter()
-    outcome = ncap_grid.run_grid(runs, results, executor)
+    with logs_above_the_bar(args.executor, args.address):
+        outcome = ncap_grid.run_grid(runs, results, executor)
     wall = time.perf_counter() - t0
     if outcome.failed:
         raise UserError(

@@ -3,15 +3,18 @@
 from __future__ import annotations
 
 import argparse
-import logging
-import os
-from collections.abc import Iterator
-from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from monopic.cli.args import positive_int
 from monopic.output import is_temporary
+from sim.commands.executor_options import (
+    add_executor_options,
+    check_executor_options,
+    logs_above_the_bar,
+    make_executor,
+    workers_of,
+)
 
 if TYPE_CHECKING:  # the simulator is imported when the command runs
     from sim.runs.run_spec import RunSpec
@@ -33,16 +36,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--out", type=Path, help="results file to append to (default: recordings/<name>.jsonl)"
     )
-    p.add_argument(
-        "--workers", type=positive_int, help="local worker processes (>= 1; default: all cores)"
-    )
-    p.add_argument(
-        "--executor",
-        choices=("local", "ray"),
-        default="local",
-        help="local worker processes, or Ray tasks (extra `ray`) (default %(default)s)",
-    )
-    p.add_argument("--address", help="Ray cluster address for --executor ray (e.g. host:6379)")
+    add_executor_options(p)
     p.add_argument(
         "--ablation",
         action=argparse.BooleanOptionalAction,
@@ -77,23 +71,15 @@ def register(sub: argparse._SubParsersAction) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from monopic.errors import UserError
-    from sim.runs.executors import local_executor, ray_executor
     from sim.runs.sweep import load_spec, recordings_folder, run_sweep
 
-    if args.address and args.executor != "ray":
-        raise UserError("--address is for --executor ray")
-    if args.workers and args.executor == "ray":
-        raise UserError("--workers is for --executor local (Ray schedules by the cluster's CPUs)")
+    check_executor_options(args)
     spec = load_spec(args.spec)
     out = args.out or Path("recordings") / f"{spec.name}.jsonl"
     if args.dry_run:
         dry_run(spec, out, args)
         return 0
-    if args.executor == "ray":
-        executor = ray_executor(args.address)
-    else:
-        executor = local_executor(args.workers)
+    executor = make_executor(args)
     with logs_above_the_bar(args.executor, args.address):
         outcome = run_sweep(
             spec,
@@ -117,38 +103,6 @@ def run(args: argparse.Namespace) -> int:
     for run_id, error in outcome.failed[:3]:
         print(f"failed {run_id}:\n{error}")
     return 1 if outcome.failed else 0
-
-
-@contextmanager
-def logs_above_the_bar(executor: str, address: str | None = None) -> Iterator[None]:
-    """Ray's log lines (its start, the code upload, its warnings) written above the sweep's
-    progress bar through tqdm, instead of into the bar's line.
-
-    Ray logs through the 'ray' logger's own stderr handler, which exists once ray is
-    imported, so ray is imported here, before the sweep, as the executor imports it: with
-    the executor's connect timeouts set when joining a cluster (Ray reads them as it
-    loads; sim.runs.executors.RAY_CONNECT_ENV). Lines Ray's C++ core writes to stderr
-    itself bypass logging and are not redirected."""
-    if executor != "ray":
-        yield
-        return
-    from sim.runs.executors import RAY_CONNECT_ENV
-
-    joining = (address or os.environ.get("RAY_ADDRESS", "local")) != "local"
-    added = {k: v for k, v in RAY_CONNECT_ENV.items() if joining and k not in os.environ}
-    os.environ.update(added)
-    try:
-        import ray  # noqa: F401
-    except ImportError:  # the executor says how to install it
-        yield
-        return
-    finally:
-        for key in added:
-            os.environ.pop(key, None)
-    from tqdm.contrib.logging import logging_redirect_tqdm
-
-    with logging_redirect_tqdm(loggers=[logging.getLogger("ray")]):
-        yield
 
 
 def kept_recordings(folder: Path, record: str) -> str:
@@ -220,7 +174,7 @@ def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
     def ablation(r: RunSpec) -> bool:
         return r.ablation if args.ablation is None else args.ablation
 
-    workers = None if args.executor == "ray" else (args.workers or os.cpu_count() or 1)
+    workers = workers_of(args)
     time = estimate_time(
         [(r.scenario.frames, bench_frame_seconds(r.scenario.robot.camera, ablation(r)))
          for r in todo],

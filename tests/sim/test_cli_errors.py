@@ -264,7 +264,7 @@ def test_record_checks_a_case_as_a_scenario_file_checks_it(
     assert not (tmp_path / "x.rrd").exists()
 
 
-@pytest.mark.parametrize("command", ["sweep", "dataset"])
+@pytest.mark.parametrize("command", ["sweep", "dataset", "closed-loop", "ncap"])
 @pytest.mark.parametrize(
     ("options", "expected"),
     [
@@ -276,8 +276,10 @@ def test_the_executor_options_refuse_what_they_cannot_apply(
     tmp_path: Path, capsys: pytest.CaptureFixture[str], command: str, options: list[str],
     expected: str,
 ) -> None:  # fmt: skip
-    out = tmp_path / ("out" if command == "dataset" else "out.jsonl")
-    assert main([command, str(DEMO), "--out", str(out), *options]) == 2
+    out = tmp_path / ("out" if command in ("dataset", "ncap") else "out.jsonl")
+    given = {"sweep": [str(DEMO)], "dataset": [str(DEMO)], "ncap": [],
+             "closed-loop": ["--cases", "5"]}[command]  # fmt: skip
+    assert main([command, *given, "--out", str(out), *options]) == 2
     assert expected in one_line_error(capsys)
     assert not out.exists()
 
@@ -444,7 +446,7 @@ def test_ray_log_lines_go_above_the_progress_bar_not_into_it(
 
     from tqdm import tqdm
 
-    from sim.commands.sweep import logs_above_the_bar
+    from sim.commands.executor_options import logs_above_the_bar
 
     pytest.importorskip("ray")
     ray_logger = logging.getLogger("ray")
