@@ -156,3 +156,12 @@ def test_every_renamed_option_keeps_its_old_name_as_a_warning_alias(capsys) -> N
         assert err == f"{parser.prog}: warning: {old} is deprecated, use {action.new}\n", argv
         assert f"`{old}`" in changelog and f"{action.new}`" in changelog, (command, old)
         assert old not in parser.format_help().replace(action.new, ""), (command, old)
+
+
+def test_a_command_with_actions_names_each_in_its_description() -> None:
+    """`monopic tree --help` once described two of its four actions."""
+    for command, parser in COMMANDS.items():
+        for action in parser._actions:
+            if isinstance(action, argparse._SubParsersAction) and command:
+                for name in action.choices:
+                    assert f"{command} {name}" in (parser.description or ""), (command, name)
