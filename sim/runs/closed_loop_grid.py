@@ -30,7 +30,7 @@ from monopic.errors import UserError
 from sim.runs.closed_loop import NO_BRAKE, LoopOutcome, run_closed_loop
 from sim.runs.latency import FIXED, MEASURED, LatencySetting
 from sim.runs.result import values_said
-from sim.runs.results_file import check_resumable
+from sim.runs.results_file import check_resumable, without_keys
 from sim.runs.runner import machine
 from sim.runs.sweep import SweepOutcome, rows_of, run_resumable
 from sim.scenario.files import Given, ScenarioFile, load, placed_case
@@ -257,10 +257,7 @@ OUTCOME_TIMING = ("latencies_ms",)
 
 def without_timing(row: dict[str, Any]) -> dict[str, Any]:
     """A row without its measured times, machine, code and recording (HOST_TIMING)."""
-    out = {k: v for k, v in row.items() if k not in HOST_TIMING}
-    if isinstance(out.get("outcome"), dict):
-        out["outcome"] = {k: v for k, v in out["outcome"].items() if k not in OUTCOME_TIMING}
-    return out
+    return without_keys(row, HOST_TIMING, OUTCOME_TIMING)
 
 
 Executor = Callable[[Sequence[LoopRun], Callable[[dict[str, Any]], None]], None]

@@ -31,7 +31,7 @@ from typing import Any
 
 from sim.runs.aeb import AebParams, run_aeb
 from sim.runs.latency import DECLARED, FIXED, MEASURED, LatencySetting
-from sim.runs.results_file import check_resumable
+from sim.runs.results_file import check_resumable, without_keys
 from sim.runs.runner import machine
 from sim.runs.sweep import SweepOutcome, rows_of, run_resumable
 from sim.scenario.files import ScenarioFile, load
@@ -242,10 +242,7 @@ OUTCOME_TIMING = ("latencies_ms", "latency_ms_median")
 
 def without_timing(row: dict[str, Any]) -> dict[str, Any]:
     """A result row without its measured times and machine (see HOST_TIMING)."""
-    out = {k: v for k, v in row.items() if k not in HOST_TIMING}
-    if isinstance(out.get("outcome"), dict):
-        out["outcome"] = {k: v for k, v in out["outcome"].items() if k not in OUTCOME_TIMING}
-    return out
+    return without_keys(row, HOST_TIMING, OUTCOME_TIMING)
 
 
 Executor = Callable[[Sequence[NcapRun], Callable[[dict[str, Any]], None]], None]

@@ -151,6 +151,18 @@ def check_resumable(out: Path, schema: int, restart: bool, option: str = "--out"
 LOCKED = "{path}: another sweep is writing to it; wait for it or use another --out"
 
 
+def without_keys(
+    row: dict[str, Any], top: tuple[str, ...], outcome: tuple[str, ...]
+) -> dict[str, Any]:
+    """A closed-loop or Euro NCAP row without the keys that hold the host's times, machine
+    and the like (`top`) and those of its outcome (`outcome`): what a rerun or a run under
+    load must reproduce is the rest."""
+    out = {k: v for k, v in row.items() if k not in top}
+    if isinstance(out.get("outcome"), dict):
+        out["outcome"] = {k: v for k, v in out["outcome"].items() if k not in outcome}
+    return out
+
+
 def check_unlocked(path: Path) -> None:
     """Refuse, as ResultsWriter would, a results file another writer holds (its lock);
     takes the lock for a moment and changes nothing (a dry run checks this way)."""
