@@ -42,8 +42,6 @@ def run(args: argparse.Namespace) -> int:
     from sim.runs.results_file import read_results
 
     results: Path = args.results
-    if not results.is_file():
-        raise UserError(f"{results}: no such results file")
     check_results_file(results)
     rows = list(read_results(results))
     if not rows:
@@ -52,9 +50,7 @@ def run(args: argparse.Namespace) -> int:
     metrics = compute(rows)
     beside = None
     if args.beside is not None:
-        if not args.beside.is_file():
-            raise UserError(f"--beside {args.beside}: no such results file")
-        check_results_file(args.beside)
+        check_results_file(args.beside, "--beside")
         other = list(read_results(args.beside))
         if not other:
             raise UserError(f"--beside {args.beside}: no finished runs in it yet")
@@ -70,9 +66,9 @@ def run(args: argparse.Namespace) -> int:
     return 0
 
 
-def check_results_file(path: Path) -> None:
-    """UserError unless the file's first line (blank ones skipped) is a sweep's result
-    line (JSON with an id).
+def check_results_file(path: Path, option: str | None = None) -> None:
+    """UserError unless the file exists (named with `option` when it came from one) and
+    its first line (blank ones skipped) is a sweep's result line (JSON with an id).
 
     A CSV or any other file given by mistake is named as such here, rather than by the
     results reader's advice for a bad line in a sweep's own file."""
@@ -80,6 +76,9 @@ def check_results_file(path: Path) -> None:
 
     from monopic.errors import UserError
 
+    if not path.is_file():
+        named = f"{option} {path}" if option else str(path)
+        raise UserError(f"{named}: no such results file")
     with path.open("rb") as fh:  # a results file has no blank line: any other file may
         first = next((line for line in fh if line.strip()), b"")
     if not first:

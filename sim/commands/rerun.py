@@ -66,8 +66,6 @@ def run(args: argparse.Namespace) -> int:
     from sim.runs.rebuild import Asked, code_of, find_line, first_difference, kind_of
 
     results: Path = args.results
-    if not results.is_file():
-        raise UserError(f"{results}: no such results file")
     check_results_file(results)
     line = find_line(results, args.run_id)
     kind = kind_of(line)
