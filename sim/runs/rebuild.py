@@ -165,13 +165,7 @@ def scenario_file_of(
     its id) is the run's: a file that does not is another file, or the file changed.
     UserError (one line) when none does, unless `anyway` (a line of other code, whose
     scenarios may digest differently): then the first file found."""
-    found = found_files(row.file, results) if row.file else []
-    if not found:
-        raise UserError(
-            f"{row.file or '(none)'}: no such scenario file (run {row.id} of {results} was made "
-            "from it; a relative name is looked for from this folder, the results file's and "
-            "the checkout's: run this from the folder the sweep ran in)"
-        )
+    found = files_named(row.file or "(none)", "scenario", row.id, results, "sweep")
     digests = []
     for path in found:
         scenario_file = load(path)
@@ -275,6 +269,18 @@ def found_files(name: str, results: Path) -> list[Path]:
     return list(dict.fromkeys(b / path for b in bases if (b / path).is_file()))
 
 
+def files_named(name: str, what: str, run_id: str, results: Path, made_by: str) -> list[Path]:
+    """found_files, or UserError (one line) saying where a missing file was looked for."""
+    found = found_files(name, results)
+    if not found:
+        raise UserError(
+            f"{name}: no such {what} file (run {run_id} of {results} was made from it; a "
+            "relative name is looked for from this folder, the results file's and the "
+            f"checkout's: run this from the folder the {made_by} ran in)"
+        )
+    return found
+
+
 def _not_a_line(line: dict[str, Any], asked: Asked, what: str, err: Exception) -> UserError:
     return UserError(
         f"{asked.results}: run {line.get('id')} is not {what} line as this code reads them "
@@ -306,14 +312,7 @@ def rebuild_loop_line(line: dict[str, Any], asked: Asked) -> Any:
         raise _not_a_line(line, asked, "a closed loop's", err) from None
     files: list[Path | None] = [None]
     if source.file is not None:
-        files = list(found_files(source.file, asked.results))
-        if not files:
-            raise UserError(
-                f"{source.file}: no such scenario file (run {line['id']} of {asked.results} "
-                "was made from it; a relative name is looked for from this folder, the "
-                "results file's and the checkout's: run this from the folder the closed loop "
-                "ran in)"
-            )
+        files = list(files_named(source.file, "scenario", line["id"], asked.results, "closed loop"))
     made = []
     for path in files:
         scenario = source.scenario(load(path) if path is not None else None)
@@ -374,15 +373,10 @@ def rebuild_ncap_line(line: dict[str, Any], asked: Asked) -> Any:
 
     named = {"protocol": line.get("protocol") or str(PROTOCOL_FILE),
              "car": line.get("car") or str(CAR_FILE)}  # fmt: skip
-    found = {}
-    for key, name in named.items():
-        found[key] = found_files(str(name), asked.results)
-        if not found[key]:
-            raise UserError(
-                f"{name}: no such {key} file (run {line.get('id')} of {asked.results} was made "
-                "from it; a relative name is looked for from this folder, the results file's "
-                "and the checkout's: run this from the folder the grid ran in)"
-            )
+    found = {
+        key: files_named(str(name), key, str(line.get("id")), asked.results, "grid")
+        for key, name in named.items()
+    }
     made = []
     try:
         replay = replay_latencies(line)
