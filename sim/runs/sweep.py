@@ -294,6 +294,7 @@ class OutputCheck:
     """What a sweep found at its output before its first run (check_output)."""
 
     state: ResultsState | None  # the results file as it stands (None: not there yet)
+    code: str  # the code version the sweep's lines carry (sweep_code)
     folder: Path  # where the recordings go
     moves: tuple[tuple[Path, Path], ...] = ()  # --restart: what is set aside first
 
@@ -362,7 +363,7 @@ def check_output(
         )
         _check_makeable(folder, message.format(path=folder, reason="a file is in the way"))
         _check_writable(folder, message)
-    return OutputCheck(state, folder, tuple(moves))
+    return OutputCheck(state, code, folder, tuple(moves))
 
 
 def _check_makeable(folder: Path, message: str) -> None:
@@ -431,7 +432,7 @@ def run_sweep(
         runs = [replace(r, ablation=ablation) for r in runs]
     check = check_output(spec, out, record, record_dir, restart)
     folder = check.folder
-    runs = [replace(r, record=record, record_dir=str(folder), code=sweep_code(spec)) for r in runs]
+    runs = [replace(r, record=record, record_dir=str(folder), code=check.code) for r in runs]
     output_folder(out.parent, "--out")
     set_aside(list(check.moves))
     # The lock held, no other sweep of this results file writes recordings: the
