@@ -1,0 +1,1 @@
+"""Everyone in view: person boxes, their motion, association and the multi-person tracker."""
