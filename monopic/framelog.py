@@ -1,14 +1,15 @@
-"""Per-frame CSV rows: the authors' log columns, then ours.
+"""Per-frame CSV rows, one per person seen: the authors' log columns, then ours.
 
 The authors' columns (../shared/data/authors-testdata/README.md) let their analysis and our replay
-read our runs; ours add the case, foot and ground points and per-stage milliseconds.
+read our runs; ours add the case, foot and ground points, per-stage milliseconds (the
+frame's, on each of its rows), and who the row is about: `personId` and their box.
 """
 
 from __future__ import annotations
 
 import math
 
-from monopic.pipeline import FrameResult
+from monopic.pipeline import FrameResult, PersonResult
 from monopic.pose.skeleton import LEFT_SHOULDER, RIGHT_SHOULDER
 from monopic.predict.rules import IMAGE_DEAD_ZONE_PX_S
 
@@ -27,14 +28,27 @@ OUR_COLUMNS = (
     # Intent features (docs/intent/features.md), empty where not known.
     "phiRate", "headYaw", "headVisibility", "groundSpeed", "groundAcceleration",
     "groundHeadingRate", "pathOffset", "pathDistance", "headFacing", "headToward",
+    # Who: an identity kept while they are followed, and their box (pixels).
+    "personId", "boxLeft", "boxTop", "boxWidth", "boxHeight",
 )  # fmt: skip
 FRAME_COLUMNS = AUTHORS_COLUMNS + OUR_COLUMNS
 
 
-def frame_row(r: FrameResult, fps: float, horizon: float) -> list:
-    """One CSV row for a frame whose pedestrian was found (features present)."""
-    f, p, w = r.features, r.prediction, r.warning
-    pose = r.pose.pose
+def frame_rows(r: FrameResult, fps: float, horizon: float) -> list[list]:
+    """The frame's rows: one per person whose landmarks were run and read this frame."""
+    return [frame_row(r, fps, horizon, p) for p in r.people if p.features is not None]
+
+
+def frame_row(
+    r: FrameResult, fps: float, horizon: float, person: PersonResult | None = None
+) -> list:
+    """One CSV row for a person found with features: `person`, or the frame's own (the
+    person whose warning is the robot's)."""
+    if person is None:
+        person = next(p for p in r.people if p.person_id == r.person_id)
+    f, p, w = person.features, person.prediction, person.warning
+    pose = person.pose
+    assert f is not None and pose is not None, "rows are for people with features"
     ls, rs = pose.landmarks[LEFT_SHOULDER], pose.landmarks[RIGHT_SHOULDER]
     g = f.ground
     pg = p.ground if p is not None else None
@@ -62,7 +76,13 @@ def frame_row(r: FrameResult, fps: float, horizon: float) -> list:
         _cell(g.heading_rate if g else nan, 2), _cell(g.path_offset if g else nan, 3),
         _cell(g.path_distance if g else nan, 3), _cell(f.head_facing, 2),
         _cell(f.head_toward, 2),
+        person.person_id, *(f"{v:.2f}" for v in _left_top_size(person.box)),
     ]  # fmt: skip
+
+
+def _left_top_size(box: tuple[float, float, float, float]) -> tuple[float, ...]:
+    x0, y0, x1, y1 = box
+    return x0, y0, x1 - x0, y1 - y0
 
 
 def _cell(value: float, digits: int) -> str:
@@ -79,3 +99,13 @@ def authors_finite(row: list) -> bool:
         return all(math.isfinite(float(v)) for v in row[: len(AUTHORS_COLUMNS)])
     except ValueError:
         return False
+
+
+def mot_rows(r: FrameResult, frame_number: int) -> list[list]:
+    """The frame's lines of a MOTChallenge results file, one per person in view:
+    frame, id, bb_left, bb_top, bb_width, bb_height, conf, x, y, z (world unknown: -1)."""
+    return [
+        [frame_number, p.person_id, *(f"{v:.2f}" for v in _left_top_size(p.box)),
+         f"{p.pose.score:.3f}" if p.pose is not None else "1", -1, -1, -1]
+        for p in r.people
+    ]  # fmt: skip

@@ -2,6 +2,9 @@
 
 Top-left: frame rate, latency (ms) and phi, as in the paper. Skeleton with the shoulders
 highlighted, the robot's zone, the predicted point and path, the case, and the risk.
+With several people in view each is drawn in their own colour (by identity,
+monopic.people.colour): box, skeleton, "id N" with their case, and their predicted
+point; the zone takes the robot's warning (the worst person's), and the banner names that person.
 """
 
 from __future__ import annotations
@@ -9,7 +12,8 @@ from __future__ import annotations
 import cv2
 import numpy as np
 
-from monopic.pipeline import FrameResult, Variant
+from monopic.people.colour import person_colour
+from monopic.pipeline import FrameResult, PersonResult, Variant
 from monopic.pose.skeleton import CONNECTIONS, LEFT_SHOULDER, RIGHT_SHOULDER
 from monopic.variants.warning import Risk
 
@@ -42,6 +46,14 @@ def draw(image: np.ndarray, result: FrameResult, variant: Variant, fps: float) -
         cv2.fillPoly(overlay, [zone], colour)
         out = cv2.addWeighted(overlay, 0.18, out, 0.82, 0)
         cv2.polylines(out, [zone], True, colour, thick, cv2.LINE_AA)
+    if len(result.people) > 1:
+        for person in result.people:
+            _person(out, person, scale, thick)
+        _text(out, f"{fps:5.1f}  {result.stage_ms.get('total', 0.0):5.1f} ms", (8, 22))
+        if w is not None and w.collision and variant is Variant.WARNING:
+            banner = f"COLLISION IMMINENT: id {result.person_id}"
+            _text(out, banner, (8, int(50 * scale)), RISK_COLOURS[Risk.RED], 1.0)
+        return out
     pose = result.pose.pose
     if pose is not None:
         lm = pose.landmarks
@@ -73,6 +85,31 @@ def draw(image: np.ndarray, result: FrameResult, variant: Variant, fps: float) -
     if w is not None and w.collision and variant is Variant.WARNING:
         _text(out, "COLLISION IMMINENT", (8, int(50 * scale)), RISK_COLOURS[Risk.RED], 1.0)
     return out
+
+
+def _person(out: np.ndarray, person: PersonResult, scale: float, thick: int) -> None:
+    """One of several people, in their own colour: box, skeleton, id and case, prediction."""
+    colour = person_colour(person.person_id)
+    x0, y0, x1, y1 = person.box
+    if not _finite(person.box):
+        return
+    cv2.rectangle(out, _pt((x0, y0)), _pt((x1, y1)), colour, max(1, thick // 2), cv2.LINE_AA)
+    pose = person.pose
+    if pose is not None:
+        lm = pose.landmarks
+        for a, b in CONNECTIONS:
+            if pose.visibility[a] > 0.3 and pose.visibility[b] > 0.3:
+                cv2.line(out, _pt(lm[a]), _pt(lm[b]), colour, thick, cv2.LINE_AA)
+        for i in (LEFT_SHOULDER, RIGHT_SHOULDER):
+            cv2.circle(out, _pt(lm[i]), 2 * thick, SHOULDERS, -1, cv2.LINE_AA)
+    label = f"id {person.person_id}"
+    p = person.prediction
+    if p is not None and _finite(p.center):
+        label += f" case {int(p.case)}"
+        centre = ((x0 + x1) / 2, (y0 + y1) / 2)
+        cv2.arrowedLine(out, _pt(centre), _pt(p.center), colour, thick, cv2.LINE_AA, tipLength=0.2)
+        cv2.circle(out, _pt(p.center), 4 * thick, colour, thick, cv2.LINE_AA)
+    _text(out, label, (_pt((x0, y0))[0], max(int(16 * scale), _pt((x0, y0))[1] - 4)), colour, 0.45)
 
 
 def _text(img, text, org, colour=(255, 255, 255), size: float = 0.6) -> None:

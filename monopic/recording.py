@@ -6,6 +6,9 @@ world, topdown, truth, ttc, alarm, robot):
 - camera/pose              BlazePose skeleton as keypoints (names, connections)
 - camera/zone              the robot's zone on the image
 - camera/prediction/point  predicted centre at the horizon; .../path the projected path
+  (these three are the robot's: the person whose warning is the worst)
+- camera/people/{id}       everyone seen, one entity per identity: box (labelled with id
+                           and case), pose, prediction; cleared when the person is gone
 - features/{phi,vx,vy}     time series; latency/{stage} per-stage milliseconds
 - events                   the warning's onset and end, each line starting with its time
 Frames are indexed on the `frame` timeline and on `time` (seconds of the stream).
@@ -38,6 +41,7 @@ import rerun.blueprint as rrb
 
 from monopic.closing import WholeOrNothing
 from monopic.output import remove_stale_temporaries, temporary_sibling
+from monopic.people.colour import person_colour
 from monopic.pipeline import FrameResult
 from monopic.pose.skeleton import CONNECTIONS, LANDMARK_NAMES
 from monopic.rerun_file import release, save_with_blueprint
@@ -154,19 +158,18 @@ class RunRecording(WholeOrNothing):
         self._warned = False  # the primary predictor's warning on the last processed frame
         if layout is not None:
             self.start(layout)
-        self.rec.log(
-            "camera/pose",
-            rr.AnnotationContext(
-                rr.ClassDescription(
-                    info=rr.AnnotationInfo(id=0, label="person", color=PIPELINE_COLOUR),
-                    keypoint_annotations=[
-                        rr.AnnotationInfo(id=i, label=name) for i, name in enumerate(LANDMARK_NAMES)
-                    ],
-                    keypoint_connections=list(CONNECTIONS),
-                )
-            ),
-            static=True,
+        skeleton = rr.AnnotationContext(
+            rr.ClassDescription(
+                info=rr.AnnotationInfo(id=0, label="person", color=PIPELINE_COLOUR),
+                keypoint_annotations=[
+                    rr.AnnotationInfo(id=i, label=name) for i, name in enumerate(LANDMARK_NAMES)
+                ],
+                keypoint_connections=list(CONNECTIONS),
+            )
         )
+        self.rec.log("camera/pose", skeleton, static=True)
+        self.rec.log("camera/people", skeleton, static=True)
+        self._people: set[int] = set()  # identities with entities now
         for name, colour in FEATURE_COLOURS.items():
             self.rec.log(
                 f"features/{name}", rr.SeriesLines(names=name, colors=[colour]), static=True
@@ -226,8 +229,10 @@ class RunRecording(WholeOrNothing):
             zone = np.vstack([w.zone, w.zone[:1]])
             rec.log("camera/zone", rr.LineStrips2D([zone], colors=[RISK_COLOURS[w.risk]]))
             if w.collision and not self._warned:
+                who = f"id {result.person_id}, " if result.person_id is not None else ""
                 self.log_event(
-                    f"COLLISION IMMINENT ({result.primary}): case {int(p.case)} ({p.case.label})",
+                    f"COLLISION IMMINENT ({result.primary}): {who}case {int(p.case)} "
+                    f"({p.case.label})",
                     rr.TextLogLevel.WARN,
                 )
             elif self._warned and not w.collision:
@@ -261,6 +266,46 @@ class RunRecording(WholeOrNothing):
         for stage in LATENCY_STAGES:
             if stage in result.stage_ms:
                 rec.log(f"latency/{stage}", rr.Scalars(result.stage_ms[stage]))
+        self._log_people(result)
+
+    def _log_people(self, result: FrameResult) -> None:
+        """One entity per person seen; those gone since the last frame are cleared."""
+        rec = self.rec
+        present = set()
+        for person in result.people:
+            entity = f"camera/people/{person.person_id}"
+            present.add(person.person_id)
+            colour = person_colour(person.person_id)
+            p = person.prediction
+            label = f"id {person.person_id}" + (f" case {int(p.case)}" if p is not None else "")
+            x0, y0, x1, y1 = person.box
+            rec.log(
+                f"{entity}/box",
+                rr.Boxes2D(
+                    mins=[[x0, y0]], sizes=[[x1 - x0, y1 - y0]], labels=[label], colors=[colour]
+                ),
+            )
+            if person.pose is not None:
+                rec.log(
+                    f"{entity}/pose",
+                    rr.Points2D(
+                        person.pose.landmarks[:, :2],
+                        class_ids=0,
+                        keypoint_ids=np.arange(len(LANDMARK_NAMES)),
+                        colors=[colour],
+                        radii=-2.0,
+                    ),
+                )
+            else:
+                rec.log(f"{entity}/pose", rr.Clear(recursive=False))
+            if p is not None:
+                point = rr.Points2D([p.center], colors=[colour], radii=-5.0)
+                rec.log(f"{entity}/prediction", point)
+            else:
+                rec.log(f"{entity}/prediction", rr.Clear(recursive=False))
+        for gone in sorted(self._people - present):
+            rec.log(f"camera/people/{gone}", rr.Clear(recursive=True))
+        self._people = present
 
     def close(self) -> None:
         """Flush and move the finished file into place (or, if that fails or is
