@@ -153,7 +153,18 @@ def positive_int(text: str) -> int:
     return value
 
 
+def non_negative_int(text: str) -> int:
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"must be >= 0, got {text!r}")
+    return value
+
+
 positive_int.range_text = ">= 1"  # type: ignore[attr-defined]
+non_negative_int.range_text = ">= 0"  # type: ignore[attr-defined]
 
 
 def output_folder(folder: Path, option: str) -> Path:

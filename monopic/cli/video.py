@@ -15,6 +15,7 @@ from monopic.camera import CameraModel
 from monopic.cli.args import (
     deprecated_alias,
     non_negative_float,
+    non_negative_int,
     output_file,
     positive_float,
     positive_int,
@@ -23,9 +24,10 @@ from monopic.cli.args import (
 from monopic.errors import UserError
 from monopic.features.extractor import GroundColumn
 from monopic.frame import EgoState
-from monopic.framelog import FRAME_COLUMNS, authors_finite, frame_row
+from monopic.framelog import FRAME_COLUMNS, authors_finite, frame_rows, mot_rows
 from monopic.output import atomic_path
 from monopic.overlay import draw
+from monopic.people.tracker import PeopleConfig
 from monopic.pipeline import Pipeline, PipelineConfig, Variant
 from monopic.pose.sessions import (
     DEFAULT_DETECTOR_MODEL,
@@ -50,9 +52,12 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="run the pipeline on a video file or camera",
         description="Run the pipeline (pose, facing angle phi, image velocity, the motion case, "
         "the point a second ahead, the collision warning) on every frame of a video or camera "
-        "and write what you ask for: an annotated video (--out), one CSV row per frame with "
-        "a person (--csv) and/or a rerun recording (--rrd); at least one is needed. Folders "
-        "are made as needed; every output appears whole or not at all.",
+        "and write what you ask for: an annotated video (--out), one CSV row per person "
+        "per frame (--csv), a MOTChallenge tracks file (--tracks) and/or a rerun "
+        "recording (--rrd); at least one is needed. Everyone in view is followed with an "
+        "identity, and the robot's warning is the worst person's; --max-people 1 is the "
+        "one-pedestrian tracker (MediaPipe's wiring). Folders are made as needed; every "
+        "output appears whole or not at all.",
     )
     p.add_argument("input", help="video file OpenCV reads, or a camera index such as 0")
     p.add_argument(
@@ -68,6 +73,44 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--csv", type=Path, metavar="FRAMES.csv", help="per-frame CSV (authors' columns plus ours)"
     )
     p.add_argument("--rrd", type=Path, metavar="RUN.rrd", help="rerun recording to write")
+    p.add_argument(
+        "--tracks",
+        type=Path,
+        metavar="TRACKS.txt",
+        help="MOTChallenge results file: one line per person per frame (frame, id, box); "
+        "score it with `monopic track-eval`",
+    )
+    people = p.add_argument_group("people (everyone in view)")
+    people.add_argument(
+        "--max-people",
+        type=positive_int,
+        default=None,
+        help="follow at most this many people (>= 1; default: everyone found); 1 is the "
+        "one-pedestrian tracker: the most confident person, followed until lost",
+    )
+    people.add_argument(
+        "--budget",
+        type=positive_int,
+        default=None,
+        help="landmark-model runs a frame (>= 1; default: everyone every frame), spent on "
+        "the people nearest the robot's path and closing fastest; the others move by "
+        "their boxes until their turn",
+    )
+    people.add_argument(
+        "--detect-every",
+        type=positive_int,
+        default=None,
+        help="frames between detector looks while everyone is followed (>= 1; default "
+        f"{PeopleConfig.detect_every}): a person entering is found within about this many "
+        "frames",
+    )
+    people.add_argument(
+        "--search-budget",
+        type=non_negative_int,
+        default=TrackerConfig.search_budget,
+        help="detector windows a look may spend: the whole frame, then the next tiles for "
+        "small people (>= 0; 0: every tile each look, for offline runs; default %(default)d)",
+    )
     p.add_argument(
         "--horizon",
         type=positive_float,
@@ -174,10 +217,24 @@ def run(args: argparse.Namespace) -> int:
     mode = Mode(args.mode)
     if mode is Mode.GROUND and ego is None:
         raise UserError("--mode ground needs the camera geometry: --fov and --camera-height")
-    if args.out is None and args.csv is None and args.rrd is None:
+    if args.out is None and args.csv is None and args.rrd is None and args.tracks is None:
         raise UserError(
-            "nothing to write: give --out VIDEO.mp4, --csv FRAMES.csv and/or --rrd RUN.rrd "
-            "(without them the run would only count the frames with a person)"
+            "nothing to write: give --out VIDEO.mp4, --csv FRAMES.csv, --tracks TRACKS.txt "
+            "and/or --rrd RUN.rrd (without them the run would only count the frames with a "
+            "person)"
+        )
+    everyone = args.max_people != 1
+    if not everyone:
+        for option, value in (("--budget", args.budget), ("--detect-every", args.detect_every)):
+            if value is not None:
+                raise UserError(
+                    f"{option} {value}: the one-pedestrian tracker (--max-people 1) runs "
+                    "the landmark model on its one person every frame"
+                )
+    if args.budget is not None and args.max_people is not None and args.budget > args.max_people:
+        raise UserError(
+            f"--budget {args.budget}: more landmark runs than people (--max-people "
+            f"{args.max_people})"
         )
     predictor = make_predictor(args.predictor, mode, args.tree)
     try:
@@ -194,7 +251,13 @@ def run(args: argparse.Namespace) -> int:
                 check(value)
         except ValueError as err:
             raise UserError(f"{option} {value}: {err}") from None
-    for option, out in (("--out", args.out), ("--csv", args.csv), ("--rrd", args.rrd)):
+    outputs = (
+        ("--out", args.out),
+        ("--csv", args.csv),
+        ("--rrd", args.rrd),
+        ("--tracks", args.tracks),
+    )
+    for option, out in outputs:
         if out is not None:
             output_file(out, option)
     pipeline = Pipeline(
@@ -208,15 +271,25 @@ def run(args: argparse.Namespace) -> int:
                 detector=args.detector,
                 window_detector=args.window_detector,
                 runtime=args.runtime,
+                search_budget=args.search_budget,
             ),
             ground_column=GroundColumn(args.ground_column),
+            people=PeopleConfig(
+                max_people=args.max_people,
+                budget=args.budget,
+                detect_every=args.detect_every or PeopleConfig.detect_every,
+            )
+            if everyone
+            else None,
         ),
         predictor,
     )
     variant = Variant(args.variant)
     found = frames = 0
+    identities: set[int] = set()
+    most = 0
     with ExitStack() as stack:
-        writer = csv_writer = recording = None
+        writer = csv_writer = recording = tracks = None
         if args.out is not None:
             tmp = stack.enter_context(atomic_path(args.out))
             fps = source.fps if source.fps > 0 else 15.0
@@ -231,6 +304,9 @@ def run(args: argparse.Namespace) -> int:
             handle = stack.enter_context(open(tmp, "w", newline=""))
             csv_writer = csv.writer(handle)
             csv_writer.writerow(FRAME_COLUMNS)
+        if args.tracks is not None:
+            tmp = stack.enter_context(atomic_path(args.tracks))
+            tracks = csv.writer(stack.enter_context(open(tmp, "w", newline="")))
         if args.rrd is not None:
             from monopic.recording import RunRecording
 
@@ -241,21 +317,38 @@ def run(args: argparse.Namespace) -> int:
         for frame in bar:
             result = pipeline.process(frame)
             frames += 1
-            found += result.pose.found
+            found += bool(result.people)
+            identities.update(p.person_id for p in result.people)
+            most = max(most, len(result.people))
             now = time.perf_counter()
             fps_now = 1.0 / max(now - last, 1e-6)
             last = now
             if writer is not None:
                 annotated = draw(frame.image, result, variant, fps_now)
                 writer.write(cv2.cvtColor(annotated, cv2.COLOR_RGB2BGR))
-            if csv_writer is not None and result.features is not None:
-                row = frame_row(result, fps_now, args.horizon)
-                if authors_finite(row):
-                    csv_writer.writerow(row)
+            if csv_writer is not None:
+                for row in frame_rows(result, fps_now, args.horizon):
+                    if authors_finite(row):
+                        csv_writer.writerow(row)
+            if tracks is not None:
+                tracks.writerows(mot_rows(result, frame.index + 1))
             if recording is not None:
                 recording.log_frame(frame.image, result)
-    print(f"{frames} frames, person found in {found} ({100 * found / max(frames, 1):.0f} %)")
-    for label, path in (("video", args.out), ("csv", args.csv), ("recording", args.rrd)):
+    share = f"{100 * found / max(frames, 1):.0f} %"
+    if everyone:
+        print(
+            f"{frames} frames, people seen in {found} ({share}); {len(identities)} identities, "
+            f"at most {most} at once"
+        )
+    else:
+        print(f"{frames} frames, person found in {found} ({share})")
+    labels = (
+        ("video", args.out),
+        ("csv", args.csv),
+        ("tracks", args.tracks),
+        ("recording", args.rrd),
+    )
+    for label, path in labels:
         if path is not None:
             print(f"{label}: {path}")
     return 0
