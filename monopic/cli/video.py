@@ -41,20 +41,33 @@ from monopic.pose.sessions import (
 from monopic.pose.tracker import TrackerConfig
 from monopic.predict.base import Mode
 from monopic.predict.registry import make_predictor, predictor_names
-from monopic.video import VideoSource
+from monopic.video import open_source
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "video",
-        help="run the pipeline on a video file or camera",
+        help="run the pipeline on a video file, a camera or an image sequence",
         description="Run the pipeline (pose, facing angle phi, image velocity, the motion case, "
-        "the point a second ahead, the collision warning) on every frame of a video or camera "
-        "and write what you ask for: an annotated video (--out), one CSV row per frame with "
-        "a person (--csv) and/or a rerun recording (--rrd); at least one is needed. Folders "
-        "are made as needed; every output appears whole or not at all.",
+        "the point a second ahead, the collision warning) on every frame of a video, a camera "
+        "or an image sequence and write what you ask for: an annotated video (--out), one CSV "
+        "row per frame with a person (--csv) and/or a rerun recording (--rrd); at least one "
+        "is needed. Folders are made as needed; every output appears whole or not at all.",
     )
-    p.add_argument("input", help="video file OpenCV reads, or a camera index such as 0")
+    p.add_argument(
+        "input",
+        help="video file OpenCV reads, a camera index such as 0, a MOTChallenge sequence "
+        "folder (with its seqinfo.ini) or a printf pattern of numbered images such as "
+        "img1/%%06d.jpg",
+    )
+    p.add_argument(
+        "--fps",
+        type=positive_float,
+        help="frame rate of an image pattern, which needs it unless it lies in a "
+        "MOTChallenge folder (> 0); a MOTChallenge folder keeps its seqinfo.ini frameRate, a "
+        "video file its own timestamps (--fps only where it declares no rate), a camera the "
+        "wall clock",
+    )
     p.add_argument(
         "--variant",
         choices=[v.value for v in Variant],
@@ -168,7 +181,7 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"unknown variant {args.variant!r}")
     if args.spin and args.threads < 2:
         raise UserError(f"--spin needs --threads 2 or more (got --threads {args.threads})")
-    source = VideoSource(args.input)
+    source = open_source(args.input, args.fps)
     ego = _ego(args, source.width, source.height)
     source.ego = ego
     mode = Mode(args.mode)

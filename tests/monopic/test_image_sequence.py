@@ -228,3 +228,55 @@ def test_the_real_pets09_sequence_reads_at_7_fps_768x576():
     # The frames differ (people walk): the sequence is not one image read three times.
     assert not np.array_equal(frames[0].image, frames[2].image)
 
+
+def cli_refusal(capsys, *args: str, progress: bool = False) -> str:
+    """The one line `monopic video ARGS` ends with, exit status 2. With `progress`, the
+    refusal came mid-run: the progress bar's line, closed, may stand above it."""
+    from monopic.cli.main import main
+
+    try:
+        status = main(["video", *args])
+    except SystemExit as stop:  # a value argparse refuses ends in a usage error
+        status = stop.code
+    assert status == 2
+    lines = capsys.readouterr().err.strip().splitlines()
+    if progress:
+        assert [n for n, line in enumerate(lines) if "error" in line] == [len(lines) - 1]
+        return lines[-1]
+    (line,) = lines
+    return line
+
+
+def test_bad_sequences_through_the_command_are_one_line_and_write_nothing(tmp_path, capsys):
+    write_images(tmp_path / "p", ["1.png", "2.png"])
+    ini = "[Sequence]\nimDir=img1\nimExt=.png\n"
+    folder = mot_folder(tmp_path / "seq", ini)
+    out = tmp_path / "out" / "frames.csv"
+    pattern = str(tmp_path / "p" / "%d.png")
+    cases = [
+        ((pattern,), f"{pattern}: an image sequence has no frame rate"),
+        ((str(tmp_path / "p" / "%06d.png"), "--fps", "7"), "the pattern matches no image"),
+        ((str(folder),), f"{folder / 'seqinfo.ini'}: [Sequence] has no frameRate"),
+        ((pattern, "--fps", "0"), "--fps: "),
+        ((pattern, "--fps", "-7"), "--fps: "),
+    ]
+    for args, expected in cases:
+        line = cli_refusal(capsys, *args, "--csv", str(out))
+        assert line.startswith("monopic video: ") and expected in line, (args, line)
+    assert not (tmp_path / "out").exists()
+
+
+def test_an_image_refused_mid_run_leaves_no_output(tmp_path, capsys):
+    """The sizes are checked as the frames are read: the run stops at the odd one out and
+    its outputs, already begun, are not left behind (whole or not at all)."""
+    write_images(tmp_path, ["1.png", "2.png"], size=(64, 48))
+    write_images(tmp_path, ["3.png"], size=(48, 64))
+    out = tmp_path / "out"
+    out.mkdir()
+    line = cli_refusal(
+        capsys, str(tmp_path / "%d.png"), "--fps", "7", "--csv", str(out / "f.csv"), progress=True
+    )
+    assert line.endswith(
+        f"{tmp_path / '3.png'}: 48x64, but the sequence's first image 1.png is 64x48"
+    )
+    assert list(out.iterdir()) == []
