@@ -1,7 +1,10 @@
-"""Frames from any video file or camera OpenCV reads, with their own timestamps.
+"""Frames from any video file or camera OpenCV reads, with their own timestamps, and
+`open_source`, which picks the reader for what the user named (an image sequence's is
+monopic.image_sequence).
 
 Velocities are computed from timestamps, never from an assumed frame rate: a file's
-frames carry the container's presentation times; a live camera's, the wall clock.
+frames carry the container's presentation times; a live camera's, the wall clock. A
+frame rate given by the user is used only where the file declares none.
 """
 
 from __future__ import annotations
@@ -16,6 +19,7 @@ import cv2
 
 from monopic.errors import UserError
 from monopic.frame import EgoState, Frame
+from monopic.image_sequence import ImageSequenceSource
 
 
 @dataclass
@@ -24,6 +28,7 @@ class VideoSource:
 
     source: str
     ego: EgoState | None = None
+    fallback_fps: float | None = None  # the rate of a file that declares none
 
     def __post_init__(self) -> None:
         self.live = self.source.isdigit()
@@ -37,6 +42,8 @@ class VideoSource:
         self.width = int(self.capture.get(cv2.CAP_PROP_FRAME_WIDTH))
         self.height = int(self.capture.get(cv2.CAP_PROP_FRAME_HEIGHT))
         self.fps = float(self.capture.get(cv2.CAP_PROP_FPS) or 0.0)
+        if not (self.fps > 0) and self.fallback_fps is not None and not self.live:
+            self.fps = self.fallback_fps
         count = int(self.capture.get(cv2.CAP_PROP_FRAME_COUNT))
         self.frame_count = count if count > 0 and not self.live else None
 
@@ -65,3 +72,19 @@ class VideoSource:
                 index += 1
         finally:
             self.capture.release()
+
+
+def open_source(text: str, fps: float | None = None) -> VideoSource | ImageSequenceSource:
+    """The frames `text` names: a camera index (digits), a video file, a MOTChallenge
+    sequence folder, or a printf pattern of numbered images (img1/%06d.jpg).
+
+    `fps` is the rate where the input has none of its own: a pattern outside a
+    MOTChallenge folder needs it; a video file or a MOTChallenge folder keeps its own."""
+    path = Path(text)
+    if text.isdigit() or path.is_file():
+        return VideoSource(text, fallback_fps=fps)
+    if path.is_dir():
+        return ImageSequenceSource.from_folder(path, fps)
+    if "%" in path.name:
+        return ImageSequenceSource.from_pattern(text, fps)
+    return VideoSource(text)  # refuses it: no such file

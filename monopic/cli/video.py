@@ -43,23 +43,36 @@ from monopic.pose.sessions import (
 from monopic.pose.tracker import TrackerConfig
 from monopic.predict.base import Mode
 from monopic.predict.registry import make_predictor, predictor_names
-from monopic.video import VideoSource
+from monopic.video import open_source
 
 
 def register(sub: argparse._SubParsersAction) -> None:
     p = sub.add_parser(
         "video",
-        help="run the pipeline on a video file or camera",
+        help="run the pipeline on a video file, a camera or an image sequence",
         description="Run the pipeline (pose, facing angle phi, image velocity, the motion case, "
-        "the point a second ahead, the collision warning) on every frame of a video or camera "
-        "and write what you ask for: an annotated video (--out), one CSV row per person "
-        "per frame (--csv), a MOTChallenge tracks file (--tracks) and/or a rerun "
-        "recording (--rrd); at least one is needed. Everyone in view is followed with an "
-        "identity, and the robot's warning is the worst person's; --max-people 1 is the "
+        "the point a second ahead, the collision warning) on every frame of a video, a camera "
+        "or an image sequence and write what you ask for: an annotated video (--out), one CSV "
+        "row per person per frame (--csv), a MOTChallenge tracks file (--tracks) and/or a "
+        "rerun recording (--rrd); at least one is needed. Everyone in view is followed with "
+        "an identity, and the robot's warning is the worst person's; --max-people 1 is the "
         "one-pedestrian tracker (MediaPipe's wiring). Folders are made as needed; every "
         "output appears whole or not at all.",
     )
-    p.add_argument("input", help="video file OpenCV reads, or a camera index such as 0")
+    p.add_argument(
+        "input",
+        help="video file OpenCV reads, a camera index such as 0, a MOTChallenge sequence "
+        "folder (with its seqinfo.ini) or a printf pattern of numbered images such as "
+        "img1/%%06d.jpg",
+    )
+    p.add_argument(
+        "--fps",
+        type=positive_float,
+        help="frame rate of an image pattern, which needs it unless it lies in a "
+        "MOTChallenge folder (> 0); a MOTChallenge folder keeps its seqinfo.ini frameRate, a "
+        "video file its own timestamps (--fps only where it declares no rate), a camera the "
+        "wall clock",
+    )
     p.add_argument(
         "--variant",
         choices=[v.value for v in Variant],
@@ -211,7 +224,7 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"unknown variant {args.variant!r}")
     if args.spin and args.threads < 2:
         raise UserError(f"--spin needs --threads 2 or more (got --threads {args.threads})")
-    source = VideoSource(args.input)
+    source = open_source(args.input, args.fps)
     ego = _ego(args, source.width, source.height)
     source.ego = ego
     mode = Mode(args.mode)
@@ -313,6 +326,9 @@ def run(args: argparse.Namespace) -> int:
             recording = stack.enter_context(RunRecording(args.rrd))
         last = time.perf_counter()
         fps_now = 0.0
+        # A tracks file counts frames as the sequence does (a MOTChallenge folder's ground
+        # truth numbers them from its first file's number), a video's from 1.
+        first_number = getattr(source, "first_number", 1)
         bar = tqdm(source, total=source.frame_count, unit="frame", desc=Path(args.input).name)
         for frame in bar:
             result = pipeline.process(frame)
@@ -331,7 +347,7 @@ def run(args: argparse.Namespace) -> int:
                     if authors_finite(row):
                         csv_writer.writerow(row)
             if tracks is not None:
-                tracks.writerows(mot_rows(result, frame.index + 1))
+                tracks.writerows(mot_rows(result, frame.index + first_number))
             if recording is not None:
                 recording.log_frame(frame.image, result)
     share = f"{100 * found / max(frames, 1):.0f} %"
