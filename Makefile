@@ -12,7 +12,7 @@ install: $(STAMP)
 # (Re)install when the project's dependency pins change.
 $(STAMP): pyproject.toml requirements.lock
 	@test -x $(BIN)/python || $(PY) -m venv $(VENV)
-	$(BIN)/python -m pip install -q -c requirements.lock -e '.[dev,ray,ncap,openvino]'
+	$(BIN)/python -m pip install -q -c requirements.lock -e '.[dev,ray,ncap,openvino,tracking]'
 	@touch $(STAMP)
 
 # The pipeline on the shipped clip, then the default sweep of every case and family

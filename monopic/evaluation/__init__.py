@@ -1,0 +1,2 @@
+"""Scoring the pipeline's outputs against other people's ground truth (`monopic track-eval`:
+multi-person tracks against MOTChallenge annotations)."""
