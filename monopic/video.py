@@ -29,6 +29,9 @@ class VideoSource:
     source: str
     ego: EgoState | None = None
     fallback_fps: float | None = None  # the rate of a file that declares none
+    # A frame's number as tracks files count them (index + first_number), as in an
+    # image sequence, whose numbering starts at its first file's.
+    first_number: int = 1
 
     def __post_init__(self) -> None:
         self.live = self.source.isdigit()

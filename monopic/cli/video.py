@@ -326,9 +326,6 @@ def run(args: argparse.Namespace) -> int:
             recording = stack.enter_context(RunRecording(args.rrd))
         last = time.perf_counter()
         fps_now = 0.0
-        # A tracks file counts frames as the sequence does (a MOTChallenge folder's ground
-        # truth numbers them from its first file's number), a video's from 1.
-        first_number = getattr(source, "first_number", 1)
         bar = tqdm(source, total=source.frame_count, unit="frame", desc=Path(args.input).name)
         for frame in bar:
             result = pipeline.process(frame)
@@ -347,7 +344,7 @@ def run(args: argparse.Namespace) -> int:
                     if authors_finite(row):
                         csv_writer.writerow(row)
             if tracks is not None:
-                tracks.writerows(mot_rows(result, frame.index + first_number))
+                tracks.writerows(mot_rows(result, frame.index + source.first_number))
             if recording is not None:
                 recording.log_frame(frame.image, result)
     share = f"{100 * found / max(frames, 1):.0f} %"
