@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 from pathlib import Path
 
-from monopic.cli.args import output_file
+from monopic.cli.args import output_file, positive_int
 from monopic.cli.tree import add_training_options, training_options
 from monopic.errors import UserError
 from monopic.output import write_text_atomically
@@ -41,6 +41,13 @@ def register(subparsers: argparse._SubParsersAction) -> None:
     )
     p.add_argument("--tree", type=Path, metavar="TREE.json", help="judge with this tree")
     p.add_argument(
+        "--person",
+        type=positive_int,
+        metavar="ID",
+        help="in logs of several people (monopic video's CSV, column personId), read this "
+        "person's rows (>= 1)",
+    )
+    p.add_argument(
         "--csv",
         type=Path,
         metavar="OUT.csv",
@@ -56,7 +63,7 @@ def _replay(args: argparse.Namespace) -> int:
     model = load_model(args.tree) if args.tree is not None else None
     if model is not None and model.mode is not Mode.IMAGE:
         raise UserError(f"{args.tree}: a {model.mode.value}-mode tree; replay needs image mode")
-    prepared = [prepare(read_log(path)) for path in args.logs]
+    prepared = [prepare(read_log(path, args.person)) for path in args.logs]
     if out is not None:
         output_file(out, "--csv")
     try:

@@ -9,6 +9,10 @@ window or a horizon of 0 or below, a frame rate below 0 (0 only on the first row
 the authors' logs use for "no rate yet") and times outside [0, MAX_TIME_S]. Anything
 else is a UserError naming the file, the line (1-based line of the file; the header is
 line 1) and the column.
+
+A `monopic video` CSV of several people (a `personId` column, several people in one
+frame) holds one track per person, interleaved: one of them is read (`person`), never the
+mix.
 """
 
 from __future__ import annotations
@@ -90,8 +94,12 @@ class AuthorsLog:
         return self.occupied * FRAME_HEIGHT_PX
 
 
-def read_log(path: Path) -> AuthorsLog:
-    """Parse and validate one log; UserError on any defect."""
+PERSON_COLUMN = "personId"
+
+
+def read_log(path: Path, person: int | None = None) -> AuthorsLog:
+    """Parse and validate one log, or `person`'s rows of a log of several people;
+    UserError on any defect, and on a log of several people without `person`."""
     path = Path(path)
     try:
         raw = path.read_bytes()
@@ -109,12 +117,11 @@ def read_log(path: Path) -> AuthorsLog:
     if missing:
         raise UserError(f"{path}: line 1 (header): missing column {missing[0]!r}")
     index = {c: header.index(c) for c in COLUMNS}
+    rows = list(reader)
+    rows = _one_person(path, header, rows, person)
     values: dict[str, list[float]] = {c: [] for c in COLUMNS}
     line = 1
-    for cells in reader:
-        line = reader.line_num
-        if not cells or all(not c.strip() for c in cells):
-            continue  # blank line (e.g. trailing newline)
+    for line, cells in rows:
         if len(cells) != len(header):
             raise UserError(
                 f"{path}: line {line}: {len(cells)} cells, the header has {len(header)}"
@@ -163,6 +170,38 @@ def read_log(path: Path) -> AuthorsLog:
         predicted_x=arr["predictedX"],
         predicted_y=arr["predictedY"],
     )
+
+
+def _one_person(
+    path: Path, header: list[str], rows: list[list[str]], person: int | None
+) -> list[tuple[int, list[str]]]:
+    """The data rows with their file line numbers, blank lines dropped, only `person`'s
+    when the log names people."""
+    numbered = [
+        (k + 2, cells) for k, cells in enumerate(rows) if cells and any(c.strip() for c in cells)
+    ]
+    if PERSON_COLUMN not in header:
+        if person is not None:
+            raise UserError(f"{path}: no {PERSON_COLUMN!r} column: a one-person log")
+        return numbered
+    column = header.index(PERSON_COLUMN)
+    ids = [cells[column].strip() if column < len(cells) else "" for _, cells in numbered]
+    people = sorted(set(ids), key=lambda i: (len(i), i))
+    if person is None:
+        # One person at a time (the one-pedestrian tracker's new identity after each
+        # loss) is one track, as today; several in one frame are not.
+        frame_column = header.index("frameNumber")
+        frames = [cells[frame_column].strip() for _, cells in numbered]
+        if len(set(frames)) < len(frames) and len(people) > 1:
+            raise UserError(
+                f"{path}: rows of {len(people)} people ({PERSON_COLUMN} "
+                f"{', '.join(people[:8])}{', ...' if len(people) > 8 else ''}): one "
+                "person's track is read at a time (monopic replay --person ID)"
+            )
+        return numbered
+    if str(person) not in people:
+        raise UserError(f"{path}: column {PERSON_COLUMN!r}: no row of person {person}")
+    return [row for row, i in zip(numbered, ids, strict=True) if i == str(person)]
 
 
 def _impossible(column: str, value: float, first: bool) -> str:

@@ -98,3 +98,47 @@ def test_the_replay_command_says_so_in_one_line(
         f"monopic replay: error: {path}: line 5, column 'currentCenterX': '1000000.0' is "
         "outside any image (beyond +-100000 px)"
     )
+
+
+def _two_people(path: Path) -> Path:
+    """Two people's rows interleaved, as monopic video writes them (personId column)."""
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow([*COLUMNS, "personId"])
+        for a, b in zip(rows(), rows(), strict=True):
+            w.writerow([*(a[c] for c in COLUMNS), 1])
+            b["currentCenterX"] += 200
+            w.writerow([*(b[c] for c in COLUMNS), 4])
+    return path
+
+
+def test_a_log_of_several_people_is_read_one_person_at_a_time(tmp_path: Path) -> None:
+    path = _two_people(tmp_path / "two.csv")
+    with pytest.raises(UserError, match=r"two.csv: rows of 2 people \(personId 1, 4\)"):
+        read_log(path)
+    first, second = read_log(path, 1), read_log(path, 4)
+    assert len(first) == len(second) == 4
+    assert (second.center_x - first.center_x == 200).all()
+    with pytest.raises(UserError, match="no row of person 2"):
+        read_log(path, 2)
+    with pytest.raises(UserError, match="no 'personId' column"):
+        read_log(write(tmp_path / "one.csv", rows()), 1)
+
+
+def test_replay_refuses_a_mixed_log_in_one_line_and_reads_one_person(tmp_path, capsys):
+    path = _two_people(tmp_path / "two.csv")
+    assert main(["replay", str(path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and "--person ID" in err[0]
+    assert main(["replay", str(path), "--person", "4"]) == 0
+
+
+def test_one_person_at_a_time_under_new_identities_is_one_track(tmp_path: Path) -> None:
+    """The one-pedestrian tracker gives a person found again a new identity: one track."""
+    path = tmp_path / "relay.csv"
+    with path.open("w", newline="") as fh:
+        w = csv.writer(fh)
+        w.writerow([*COLUMNS, "personId"])
+        for k, row in enumerate(rows()):
+            w.writerow([*(row[c] for c in COLUMNS), 1 if k < 2 else 2])
+    assert len(read_log(path)) == 4
