@@ -165,6 +165,7 @@ def non_negative_int(text: str) -> int:
 
 positive_int.range_text = ">= 1"  # type: ignore[attr-defined]
 non_negative_int.range_text = ">= 0"  # type: ignore[attr-defined]
+non_negative_int.integer = True  # type: ignore[attr-defined]
 
 
 def output_folder(folder: Path, option: str) -> Path:

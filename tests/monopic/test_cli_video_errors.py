@@ -79,7 +79,7 @@ def test_no_output_asked_for_is_refused_before_any_frame(tmp_path):
     r = run(str(clip), cwd=tmp_path)
     assert r.returncode == 2 and r.stdout == ""
     (line,) = r.stderr.strip().splitlines()
-    assert "nothing to write: give --out VIDEO.mp4, --csv FRAMES.csv and/or --rrd" in line
+    assert "nothing to write: give --out VIDEO.mp4, --csv FRAMES.csv, --tracks TRACKS.txt and/or --rrd" in line
 
 
 def test_outputs_go_into_folders_made_as_needed(tmp_path):
