@@ -31,7 +31,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from monopic.people.association import associate
-from monopic.people.box import Box, contains, detection_box, hips, pose_box, valid
+from monopic.people.box import Box, detection_box, hips, pose_box, valid
 from monopic.people.motion import DETECTION_NOISE, POSE_NOISE, BoxMotion
 from monopic.people.urgency import turn, urgency
 from monopic.pose.detector import Detection, PoseDetector, iou
@@ -49,10 +49,18 @@ BOX_MARGIN = 0.1
 VISIBLE = 0.5
 # ... at most this share outside it on another person ...
 MAX_ELSEWHERE = 0.2
+# ... upright: the shoulders at least MIN_TORSO of the landmark height above the hips
+# (about 0.34 for a standing adult, 0.30 at the least on PETS09's walkers) and at most
+# MAX_LEAN of it to one side of them (0.07 at the most there) ...
+MIN_TORSO = 0.2
+MAX_LEAN = 0.2
 # ... and its box at least this share of the expected height, at most its inverse.
 MIN_HEIGHT_RATIO = 0.5
 # Two people whose boxes overlap this much are one person followed twice.
 SAME_PERSON_IOU = 0.7
+# ... and so are two poses whose hips are this close, in heights (a torso is about a
+# fifth of a height wide).
+SAME_HIPS = 0.1
 # A detection matching no one but overlapping someone this much is them, seen differently
 # (a second detection of one person); below it, a neighbour.
 NEW_PERSON_MAX_IOU = 0.5
@@ -225,7 +233,9 @@ class PeopleTracker:
         levels = search_windows(w, h, cfg.acquire_tiles, cfg.far_tiles, cfg.tile_overlap, band)
         tiles = [win for level in levels for win in level]
         room = max(len(tiles) if cfg.search_budget == 0 else cfg.search_budget - 1, 0)
-        lost = lost[:room] if cfg.search_budget else lost
+        # At least one tile a pass, so that people lost for long cannot keep the cascade
+        # from reaching someone never found.
+        lost = lost[: max(room - 1, 0)] if cfg.search_budget and tiles else lost
         take = min(len(tiles), max(room - len(lost), 0))
         start = self._next_tile % len(tiles) if tiles else 0
         chosen = [tiles[(start + k) % len(tiles)] for k in range(take)]
@@ -288,11 +298,21 @@ class PeopleTracker:
             expected = person.motion.current()
             others = [_box(p) for p in self._people if p is not person]
             slack = person.motion.position_spread()
-            if pose.score < self.config.min_pose_score or not _belongs(
-                pose, expected, others, slack
+            # A first pose on someone already followed is them, found again by a
+            # neighbour's detection: it makes no one new.
+            known = not person.posed and any(
+                iou(pose_box(pose), other) >= NEW_PERSON_MAX_IOU for other in others
+            )
+            if (
+                pose.score < self.config.min_pose_score
+                or known
+                or not _belongs(pose, expected, others, slack)
             ):
-                person.region = None  # lost: the detector finds them again
-                self._lost = True
+                person.region = None
+                if person.posed:  # lost: the detector looks for them next frame
+                    self._lost = True
+                else:  # the landmark model does not confirm the detection: no one
+                    person.last_seen = -np.inf
                 continue
             pose = person.filter.apply(pose, timestamp)
             person.pose, person.posed = pose, True
@@ -313,12 +333,19 @@ class PeopleTracker:
             if any(iou(box, _box(k)) >= SAME_PERSON_IOU for k in kept):
                 continue
             if person.pose is not None and any(
-                k.pose is not None and contains(pose_box(k.pose), hips(person.pose), -0.3)
-                for k in kept
+                k.pose is not None and _same_hips(k.pose, person.pose) for k in kept
             ):
                 continue
             kept.append(person)
         self._people = kept
+
+
+def _same_hips(a: Pose, b: Pose) -> bool:
+    """Two poses with their hips within SAME_HIPS of the taller's box height are one
+    person found twice: two people's hips lie at least a torso's width apart."""
+    (ax, ay), (bx, by) = hips(a), hips(b)
+    height = max(a.box[3] - a.box[1], b.box[3] - b.box[1], 1.0)
+    return bool(np.hypot(ax - bx, ay - by) <= SAME_HIPS * height)
 
 
 def _around(box: Box, w: int, h: int) -> Window:
@@ -354,12 +381,31 @@ def _belongs(pose: Pose, box: Box, others: list[Box], slack: float = 0.0) -> boo
         elsewhere |= _within(points, other, 0.0)
     elsewhere &= ~_within(points, box, 0.0)
     x0, y0, x1, y1 = pose.box
+    if not _upright(pose):
+        return False
     height_ratio = (pose_box(pose)[3] - pose_box(pose)[1]) / max(box[3] - box[1], 1.0)
     return bool(
         own.mean() >= MIN_INSIDE
         and elsewhere.mean() <= MAX_ELSEWHERE
         and y1 - y0 >= x1 - x0
         and MIN_HEIGHT_RATIO <= height_ratio <= 1 / MIN_HEIGHT_RATIO
+    )
+
+
+def _upright(pose: Pose) -> bool:
+    """A standing person's skeleton: the nose above the shoulders, the shoulders at least
+    MIN_TORSO of the landmark height above the hips, and the shoulders over the hips
+    (within MAX_LEAN). A skeleton assembled from two people (one's head, the other's
+    body) breaks these; a walker, even one leaning into a run, keeps them."""
+    landmarks = pose.landmarks[:, :2]
+    height = max(pose.box[3] - pose.box[1], 1.0)
+    nose = landmarks[0]
+    shoulders = landmarks[[11, 12]].mean(axis=0)
+    hips_ = landmarks[[23, 24]].mean(axis=0)
+    return bool(
+        nose[1] < shoulders[1]
+        and hips_[1] - shoulders[1] >= MIN_TORSO * height
+        and abs(hips_[0] - shoulders[0]) <= MAX_LEAN * height
     )
 
 
