@@ -17,3 +17,13 @@ needs_authors_logs = pytest.mark.skipif(
     not (AUTHORS_LOGS / "data0.csv").is_file(),
     reason=f"the authors' logs are not at {AUTHORS_LOGS} (set MONOPIC_SHARED_DATA)",
 )
+PETS09 = SHARED_DATA / "mot-pets09-s2l1"
+needs_pets09 = pytest.mark.skipif(
+    not (PETS09 / "gt" / "gt.txt").is_file(),
+    reason=f"the PETS09-S2L1 sequence is not at {PETS09} (set MONOPIC_SHARED_DATA)",
+)
+STREET_CLIP = SHARED_DATA / "street-clips" / "road_walkers_high_angle.mp4"
+needs_street_clip = pytest.mark.skipif(
+    not STREET_CLIP.is_file(),
+    reason=f"the street clip is not at {STREET_CLIP} (set MONOPIC_SHARED_DATA)",
+)

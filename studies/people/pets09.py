@@ -23,8 +23,9 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
 from collections.abc import Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -44,23 +45,35 @@ from monopic.evaluation.mot import (
 from monopic.frame import Frame
 from monopic.image_sequence import ImageSequenceSource
 from monopic.output import atomic_path
+from monopic.people.box import ABOVE_HIPS, BELOW_HIPS, HEAD_TOP, SOLE
 from monopic.people.tracker import PeopleConfig, PeopleTracker
-from monopic.pose.detector import PoseDetector
+from monopic.pose.detector import Detection, PoseDetector
 from monopic.pose.landmarks import Pose
 from monopic.pose.search import Window, search_windows
 from monopic.pose.tracker import TrackerConfig
 from monopic.pose.warp import WideFrame
 
-SEQUENCE = Path(__file__).resolve().parents[3] / "shared" / "data" / "mot-pets09-s2l1"
+# Real data is read where it is kept, never copied: $MONOPIC_SHARED_DATA, else
+# ../shared/data beside the checkout.
+ROOT = Path(__file__).resolve().parents[2]
+SHARED_DATA = Path(os.environ.get("MONOPIC_SHARED_DATA") or ROOT.parent / "shared" / "data")
+SEQUENCE = SHARED_DATA / "mot-pets09-s2l1"
 SPAN_SHARE = 0.25
 VISIBLE = 0.5
 
+# Each run: its people settings and the detector windows a frame (the tracker's bounded
+# search, or 0: the whole frame and every tile, every time it detects).
 RUNS = {
-    "landmarks": PeopleConfig(),
+    "landmarks": (PeopleConfig(), TrackerConfig.search_budget),
     # The baseline sees only the detector's boxes, so it detects every frame (the
-    # landmark tracker fills the frames between detections with poses).
-    "box-only": PeopleConfig(landmarks=False, detect_every=1),
+    # landmark tracker fills the frames between detections with poses) ...
+    "box-only": (PeopleConfig(landmarks=False, detect_every=1), TrackerConfig.search_budget),
+    # ... and, at its best, with every tile every frame (about ten times the work).
+    "box-only, every tile": (PeopleConfig(landmarks=False, detect_every=1), 0),
 }
+# A ceiling, not a tracker: the landmark tracker fed the ground truth's boxes in place of
+# the detector's (CEILING_RUN below): what a detector that finds everyone would give.
+CEILING_RUN = "landmarks, ground-truth detections (ceiling)"
 
 
 @dataclass(frozen=True)
@@ -101,14 +114,29 @@ def spans(pose: Pose, truth: Sequence[tuple[int, object]]) -> list[tuple[int, in
 
 
 def follow(
-    sequence: Path, frames: FrameRange, people: PeopleConfig, config: TrackerConfig
+    sequence: Path,
+    frames: FrameRange,
+    people: PeopleConfig,
+    config: TrackerConfig,
+    ceiling: bool = False,
 ) -> tuple[list[MotRow], list[Span]]:
-    """Run the people tracker over the frames: its tracks and its spanning poses."""
+    """Run the people tracker over the frames: its tracks and its spanning poses; with
+    `ceiling`, its detector replaced by the ground truth's scored boxes."""
     truth = read_mot(ground_truth_file(sequence))
     tracker = PeopleTracker(config, people)
+    if ceiling:
+        scored = read_mot(ground_truth_file(sequence), scored_only=True)
+        now = {"frame": 0}
+
+        def detect(w: int, h: int, band: object) -> tuple[list[Detection], int]:
+            return [_detection(box) for _, box in scored.get(now["frame"], [])], 1
+
+        tracker._detect = detect  # type: ignore[method-assign]
     rows: list[MotRow] = []
     spanning: list[Span] = []
     for number, frame in frames_of(sequence, frames):
+        if ceiling:
+            now["frame"] = number
         result = tracker.process(frame.image, frame.timestamp)
         for s in result.sightings:
             x0, y0, x1, y1 = s.box
@@ -117,6 +145,18 @@ def follow(
                 for pair in spans(s.pose, truth.get(number, [])):
                     spanning.append(Span(number, s.person_id, pair))
     return rows, spanning
+
+
+def _detection(box: Box) -> Detection:
+    """The detection monopic.people.box.detection_box turns back into `box`: its mid-hip
+    keypoint and full-body radius r (the box spans HEAD_TOP and SOLE beyond the
+    landmarks, which run from ABOVE_HIPS r above the hips to BELOW_HIPS r below)."""
+    span = ABOVE_HIPS + BELOW_HIPS
+    r = box.height / (span * (1 + HEAD_TOP + SOLE))
+    hx, hy = box.left + box.width / 2, box.top + HEAD_TOP * span * r + ABOVE_HIPS * r
+    keypoints = np.array([[hx, hy], [hx, hy - r], [hx, hy - 0.5 * r], [hx, hy - r]])
+    face = (hx - 0.1 * r, hy - r, hx + 0.1 * r, hy - 0.8 * r)
+    return Detection(1.0, face, keypoints)
 
 
 def detector_recall(
@@ -137,7 +177,9 @@ def detector_recall(
             continue
         h, w = frame.image.shape[:2]
         wide.start(frame.image)
-        levels = search_windows(w, h, config.acquire_tiles, config.far_tiles, config.tile_overlap)
+        levels = search_windows(
+            w, h, config.acquire_tiles, config.far_tiles, config.tile_overlap, None
+        )
         windows = [Window(0, 0, w, h), *(win for level in levels for win in level)]
         hips = [d.keypoints[0] for d in detector.detect(wide.whole(), windows)]
         for gt_id, box in truth.get(number, []):
@@ -201,15 +243,25 @@ def main(argv: Sequence[str] | None = None) -> None:
         "| spanning poses |",
         "| --- | --- | --- | --- | --- | --- | --- | --- |",
     ]
-    for name, people in RUNS.items():
-        tracks, done = args.out / f"{name}.txt", args.out / f"{name}.spans.json"
+    for name, (people, search_budget) in RUNS.items():
+        stem = name.replace(", ", "-").replace(" ", "-")
+        tracks, done = args.out / f"{stem}.txt", args.out / f"{stem}.spans.json"
         if not done.exists():
-            rows, spanning = follow(args.sequence, args.frames, people, config)
+            searched = replace(config, search_budget=search_budget)
+            rows, spanning = follow(args.sequence, args.frames, people, searched)
             write_tracks(tracks, rows)
             with atomic_path(done) as tmp:
                 tmp.write_text(json.dumps([[s.frame, s.person_id, *s.gt_ids] for s in spanning]))
         scores = score_tracks(read_mot_rows(tracks), truth, args.frames)
         lines.append(_row(name, scores, len(json.loads(done.read_text()))))
+    tracks, done = args.out / "ceiling.txt", args.out / "ceiling.spans.json"
+    if not done.exists():
+        rows, spanning = follow(args.sequence, args.frames, PeopleConfig(), config, ceiling=True)
+        write_tracks(tracks, rows)
+        with atomic_path(done) as tmp:
+            tmp.write_text(json.dumps([[s.frame, s.person_id, *s.gt_ids] for s in spanning]))
+    scores = score_tracks(read_mot_rows(tracks), truth, args.frames)
+    lines.append(_row(CEILING_RUN, scores, len(json.loads(done.read_text()))))
     text = "\n".join(lines) + "\n"
     with atomic_path(args.out / "summary.md") as tmp:
         tmp.write_text(text)

@@ -79,7 +79,10 @@ def test_no_output_asked_for_is_refused_before_any_frame(tmp_path):
     r = run(str(clip), cwd=tmp_path)
     assert r.returncode == 2 and r.stdout == ""
     (line,) = r.stderr.strip().splitlines()
-    assert "nothing to write: give --out VIDEO.mp4, --csv FRAMES.csv, --tracks TRACKS.txt and/or --rrd" in line
+    assert (
+        "nothing to write: give --out VIDEO.mp4, --csv FRAMES.csv, --tracks TRACKS.txt "
+        "and/or --rrd" in line
+    )
 
 
 def test_outputs_go_into_folders_made_as_needed(tmp_path):
@@ -119,3 +122,18 @@ def test_int8_models_on_a_cpu_without_vnni_are_one_line_and_write_nothing(
         (line,) = capsys.readouterr().err.strip().splitlines()
         assert line.startswith(f"monopic video: error: {option} {value}: ") and "VNNI" in line
         assert not out.exists()
+
+
+def test_people_options_out_of_range_or_contradictory_are_one_line(tmp_path):
+    clip = tiny_clip(tmp_path)
+    csv = str(tmp_path / "f.csv")
+    for args, says in (
+        (("--max-people", "0"), "--max-people: must be >= 1"),
+        (("--budget", "0"), "--budget: must be >= 1"),
+        (("--max-people", "1", "--budget", "1"), "--budget 1: the one-pedestrian tracker"),
+        (("--max-people", "2", "--budget", "3"), "--budget 3: more landmark runs than people"),
+    ):
+        r = run(str(clip), "--csv", csv, *args, cwd=tmp_path)
+        lines = r.stderr.strip().splitlines()
+        assert r.returncode == 2 and len(lines) == 1 and says in lines[0], (args, r.stderr)
+        assert not (tmp_path / "f.csv").exists()

@@ -12,9 +12,7 @@ import pytest
 from monopic.errors import UserError
 from monopic.image_sequence import ImageSequenceSource
 from monopic.video import VideoSource, open_source
-from tests.paths import SHARED_DATA
-
-PETS = SHARED_DATA / "mot-pets09-s2l1"
+from tests.paths import PETS09 as PETS
 
 
 def write_images(folder: Path, names: list[str], size: tuple[int, int] = (8, 6)) -> None:

@@ -21,13 +21,8 @@ from monopic.evaluation.mot import (
     read_mot,
     read_mot_rows,
 )
-from tests.paths import SHARED_DATA
-
-PETS = SHARED_DATA / "mot-pets09-s2l1"
-needs_pets = pytest.mark.skipif(
-    not (PETS / "gt" / "gt.txt").is_file(),
-    reason=f"the PETS09-S2L1 sequence is not at {PETS} (set MONOPIC_SHARED_DATA)",
-)
+from tests.paths import PETS09 as PETS
+from tests.paths import needs_pets09 as needs_pets
 
 # Three people walking right, 40 px apart, in frames 1-10: (frame, id, left, top, w, h).
 PEOPLE = [
