@@ -14,6 +14,7 @@ import numpy as np
 
 from monopic.people.colour import person_colour
 from monopic.pipeline import FrameResult, PersonResult, Variant
+from monopic.pose.landmarks import Pose
 from monopic.pose.skeleton import CONNECTIONS, LEFT_SHOULDER, RIGHT_SHOULDER
 from monopic.variants.warning import Risk
 
@@ -56,12 +57,8 @@ def draw(image: np.ndarray, result: FrameResult, variant: Variant, fps: float) -
         return out
     pose = result.pose.pose
     if pose is not None:
+        _skeleton(out, pose, SKELETON, thick, 3 * thick)
         lm = pose.landmarks
-        for a, b in CONNECTIONS:
-            if pose.visibility[a] > 0.3 and pose.visibility[b] > 0.3:
-                cv2.line(out, _pt(lm[a]), _pt(lm[b]), SKELETON, thick, cv2.LINE_AA)
-        for i in (LEFT_SHOULDER, RIGHT_SHOULDER):
-            cv2.circle(out, _pt(lm[i]), 3 * thick, SHOULDERS, -1, cv2.LINE_AA)
         cv2.line(out, _pt(lm[LEFT_SHOULDER]), _pt(lm[RIGHT_SHOULDER]), SHOULDERS, thick)
     f, p = result.features, result.prediction
     if f is not None and p is not None and _finite(p.center):
@@ -94,14 +91,8 @@ def _person(out: np.ndarray, person: PersonResult, scale: float, thick: int) -> 
     if not _finite(person.box):
         return
     cv2.rectangle(out, _pt((x0, y0)), _pt((x1, y1)), colour, max(1, thick // 2), cv2.LINE_AA)
-    pose = person.pose
-    if pose is not None:
-        lm = pose.landmarks
-        for a, b in CONNECTIONS:
-            if pose.visibility[a] > 0.3 and pose.visibility[b] > 0.3:
-                cv2.line(out, _pt(lm[a]), _pt(lm[b]), colour, thick, cv2.LINE_AA)
-        for i in (LEFT_SHOULDER, RIGHT_SHOULDER):
-            cv2.circle(out, _pt(lm[i]), 2 * thick, SHOULDERS, -1, cv2.LINE_AA)
+    if person.pose is not None:
+        _skeleton(out, person.pose, colour, thick, 2 * thick)
     label = f"id {person.person_id}"
     p = person.prediction
     if p is not None and _finite(p.center):
@@ -110,6 +101,16 @@ def _person(out: np.ndarray, person: PersonResult, scale: float, thick: int) -> 
         cv2.arrowedLine(out, _pt(centre), _pt(p.center), colour, thick, cv2.LINE_AA, tipLength=0.2)
         cv2.circle(out, _pt(p.center), 4 * thick, colour, thick, cv2.LINE_AA)
     _text(out, label, (_pt((x0, y0))[0], max(int(16 * scale), _pt((x0, y0))[1] - 4)), colour, 0.45)
+
+
+def _skeleton(out: np.ndarray, pose: Pose, colour, thick: int, shoulder_radius: int) -> None:
+    """The pose's visible bones in `colour`, its shoulders marked (phi is read from them)."""
+    lm = pose.landmarks
+    for a, b in CONNECTIONS:
+        if pose.visibility[a] > 0.3 and pose.visibility[b] > 0.3:
+            cv2.line(out, _pt(lm[a]), _pt(lm[b]), colour, thick, cv2.LINE_AA)
+    for i in (LEFT_SHOULDER, RIGHT_SHOULDER):
+        cv2.circle(out, _pt(lm[i]), shoulder_radius, SHOULDERS, -1, cv2.LINE_AA)
 
 
 def _text(img, text, org, colour=(255, 255, 255), size: float = 0.6) -> None:

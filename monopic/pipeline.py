@@ -69,20 +69,12 @@ class Decision:
     path: PathProjection
 
 
-@dataclass(frozen=True)
-class PersonResult:
-    """One person in one frame: identity, box, pose when run, features and decisions.
+class Decided:
+    """What a set of decisions says through its primary predictor (a person's, or the
+    robot's: the frame's)."""
 
-    `fresh` is False when the decisions are the person's last ones, carried while their
-    landmarks wait for the budget (no features this frame)."""
-
-    person_id: int
-    box: Box
-    pose: Pose | None
-    features: Features | None
     decisions: tuple[Decision, ...]
     primary: str
-    fresh: bool = True
 
     def decision(self, key: str) -> Decision | None:
         return next((d for d in self.decisions if d.predictor == key), None)
@@ -97,9 +89,30 @@ class PersonResult:
         d = self.decision(self.primary)
         return d.warning if d else None
 
+    @property
+    def path(self) -> PathProjection | None:
+        d = self.decision(self.primary)
+        return d.path if d else None
+
 
 @dataclass(frozen=True)
-class FrameResult:
+class PersonResult(Decided):
+    """One person in one frame: identity, box, pose when run, features and decisions.
+
+    `fresh` is False when the decisions are the person's last ones, carried while their
+    landmarks wait for the budget (no features this frame)."""
+
+    person_id: int
+    box: Box
+    pose: Pose | None
+    features: Features | None
+    decisions: tuple[Decision, ...]
+    primary: str
+    fresh: bool = True
+
+
+@dataclass(frozen=True)
+class FrameResult(Decided):
     """Everything the pipeline produced for one frame (pose may be absent).
 
     `decisions` holds one entry per predictor that could decide (ground-mode predictors
@@ -120,24 +133,6 @@ class FrameResult:
     primary: str = ""
     people: tuple[PersonResult, ...] = ()
     person_id: int | None = None
-
-    def decision(self, key: str) -> Decision | None:
-        return next((d for d in self.decisions if d.predictor == key), None)
-
-    @property
-    def prediction(self) -> Prediction | None:
-        d = self.decision(self.primary)
-        return d.prediction if d else None
-
-    @property
-    def warning(self) -> Warning | None:
-        d = self.decision(self.primary)
-        return d.warning if d else None
-
-    @property
-    def path(self) -> PathProjection | None:
-        d = self.decision(self.primary)
-        return d.path if d else None
 
 
 def predictor_key(predictor: Predictor) -> str:

@@ -143,29 +143,26 @@ def parameter_limit(text: str) -> tuple[str, float]:
     return name.strip(), number
 
 
-def positive_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-    if value < 1:
-        raise argparse.ArgumentTypeError(f"must be >= 1, got {text!r}")
-    return value
+def _integer_at_least(low: int, name: str) -> Callable[[str], int]:
+    """An argparse type: an integer of at least `low`, its range stated for the help."""
+
+    def parse(text: str) -> int:
+        try:
+            value = int(text)
+        except ValueError:
+            raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
+        if value < low:
+            raise argparse.ArgumentTypeError(f"must be >= {low}, got {text!r}")
+        return value
+
+    parse.__name__ = parse.__qualname__ = name
+    parse.range_text = f">= {low}"  # type: ignore[attr-defined]
+    parse.integer = True  # type: ignore[attr-defined]
+    return parse
 
 
-def non_negative_int(text: str) -> int:
-    try:
-        value = int(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected an integer, got {text!r}") from None
-    if value < 0:
-        raise argparse.ArgumentTypeError(f"must be >= 0, got {text!r}")
-    return value
-
-
-positive_int.range_text = ">= 1"  # type: ignore[attr-defined]
-non_negative_int.range_text = ">= 0"  # type: ignore[attr-defined]
-non_negative_int.integer = True  # type: ignore[attr-defined]
+positive_int = _integer_at_least(1, "positive_int")
+non_negative_int = _integer_at_least(0, "non_negative_int")
 
 
 def output_folder(folder: Path, option: str) -> Path:

@@ -264,13 +264,14 @@ def run(args: argparse.Namespace) -> int:
                 check(value)
         except ValueError as err:
             raise UserError(f"{option} {value}: {err}") from None
+    # Each output: its option, what the last lines call it, its path (None: not asked).
     outputs = (
-        ("--out", args.out),
-        ("--csv", args.csv),
-        ("--rrd", args.rrd),
-        ("--tracks", args.tracks),
+        ("--out", "video", args.out),
+        ("--csv", "csv", args.csv),
+        ("--tracks", "tracks", args.tracks),
+        ("--rrd", "recording", args.rrd),
     )
-    for option, out in outputs:
+    for option, _, out in outputs:
         if out is not None:
             output_file(out, option)
     pipeline = Pipeline(
@@ -355,13 +356,7 @@ def run(args: argparse.Namespace) -> int:
         )
     else:
         print(f"{frames} frames, person found in {found} ({share})")
-    labels = (
-        ("video", args.out),
-        ("csv", args.csv),
-        ("tracks", args.tracks),
-        ("recording", args.rrd),
-    )
-    for label, path in labels:
+    for _, label, path in outputs:
         if path is not None:
             print(f"{label}: {path}")
     return 0

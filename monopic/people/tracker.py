@@ -34,12 +34,12 @@ from monopic.people.association import associate
 from monopic.people.box import Box, detection_box, hips, pose_box, valid
 from monopic.people.motion import DETECTION_NOISE, POSE_NOISE, BoxMotion
 from monopic.people.urgency import turn, urgency
-from monopic.pose.detector import Detection, PoseDetector, iou
+from monopic.pose.detector import Detection, iou
 from monopic.pose.filtering import LandmarkFilter
 from monopic.pose.landmarks import LandmarkModel, Pose
 from monopic.pose.region import Region
 from monopic.pose.search import ZOOM_MIN_SIDE, GroundBand, Window, search_windows
-from monopic.pose.tracker import TrackerConfig
+from monopic.pose.tracker import TrackerConfig, detector_for
 from monopic.pose.warp import WideFrame
 
 # A pose is its person's when this share of its visible landmarks lies inside the
@@ -152,16 +152,7 @@ class PeopleTracker:
 
     def __post_init__(self) -> None:
         cfg = self.config
-        self.detector = PoseDetector(
-            cfg.threads,
-            cfg.min_detection_score,
-            cfg.runtime,
-            cfg.detector,
-            cfg.spin,
-            None,
-            cfg.region_scale,
-            cfg.window_detector,
-        )
+        self.detector = detector_for(cfg, None)
         self.landmarks = (
             LandmarkModel(cfg.threads, cfg.model, cfg.runtime, cfg.spin)
             if self.people.landmarks

@@ -124,22 +124,28 @@ class PoseResult:
         return self.pose is not None
 
 
+def detector_for(cfg: TrackerConfig, zoom_score: float | None) -> PoseDetector:
+    """The person detector as `cfg` sets it up; `zoom_score`, the faint candidates' score
+    worth a zoom (None: no zooms, as when everyone's detections are kept)."""
+    return PoseDetector(
+        cfg.threads,
+        cfg.min_detection_score,
+        cfg.runtime,
+        cfg.detector,
+        cfg.spin,
+        zoom_score,
+        cfg.region_scale,
+        cfg.window_detector,
+    )
+
+
 @dataclass
 class PoseTracker:
     config: TrackerConfig = field(default_factory=TrackerConfig)
 
     def __post_init__(self) -> None:
         cfg = self.config
-        self.detector = PoseDetector(
-            cfg.threads,
-            cfg.min_detection_score,
-            cfg.runtime,
-            cfg.detector,
-            cfg.spin,
-            cfg.zoom_score,
-            cfg.region_scale,
-            cfg.window_detector,
-        )
+        self.detector = detector_for(cfg, cfg.zoom_score)
         self.landmarks = LandmarkModel(cfg.threads, cfg.model, cfg.runtime, cfg.spin)
         self._region: Region | None = None
         self._next_tile = 0  # where the search resumes in the tile cascade
