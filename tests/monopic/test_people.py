@@ -203,3 +203,38 @@ def test_at_most_max_people_are_followed() -> None:
         assert len(result.sightings) <= 1
         seen.update(s.person_id for s in result.sightings)
     assert len(seen) == 1  # the one followed stays in view: no one else is taken on
+
+
+def test_outputs_carry_each_person(tmp_path) -> None:
+    """Two walkers through every output: one CSV row and one MOT line per person per
+    frame, each drawn in their own colour, and an entity each in the .rrd read back."""
+    from monopic.framelog import FRAME_COLUMNS, frame_rows, mot_rows
+    from monopic.overlay import Variant, draw
+    from monopic.people.colour import person_colour
+    from monopic.recording import RunRecording
+    from tests.rrd import rows_per_entity
+
+    pipeline = Pipeline(PipelineConfig(people=PeopleConfig()))
+    rrd = tmp_path / "two.rrd"
+    both = None
+    with RunRecording(rrd) as recording:
+        for frame in _two_walkers():
+            result = pipeline.process(frame)
+            recording.log_frame(frame.image, result)
+            rows = frame_rows(result, 15.0, 1.0)
+            ids = [row[FRAME_COLUMNS.index("personId")] for row in rows]
+            assert sorted(ids) == sorted(p.person_id for p in result.people)
+            mot = mot_rows(result, frame.index + 1)
+            assert [line[1] for line in mot] == [p.person_id for p in result.people]
+            if len(result.people) == 2:
+                both = (frame, result)
+    assert both is not None
+    frame, result = both
+    drawn = draw(frame.image, result, Variant.WARNING, 15.0)
+    for person in result.people:
+        x0, y0, x1, y1 = (int(v) for v in person.box)
+        inside = drawn[max(y0, 0) : y1 + 1, max(x0, 0) : x1 + 1].reshape(-1, 3)
+        assert (inside == person_colour(person.person_id)).all(axis=1).any(), person.person_id
+    entities = rows_per_entity(rrd)
+    for person in result.people:
+        assert entities[f"/camera/people/{person.person_id}/box"] > 0, entities
