@@ -11,9 +11,15 @@ error against the ground truth on the frames both found; CPU-seconds per frame a
 hour at 15 fps (process CPU time of the timed pass: the energy proxy). The results go to
 bench/history.jsonl as one line (bench/history.py) unless --no-append.
 
+With --people a third side runs between the two: ours following everyone in view
+(`people`: PipelineConfig(people=PeopleConfig()), the same options otherwise), so the
+one-pedestrian tracker's and everyone's ratios to the reference come from the same
+minutes (order ours, people, ref, ref, people, ours, ...); "both found" is then the frames
+all three found, and the landmark error's paired interval stays ours against the reference.
+
     .venv/bin/python -m bench.compare_reference [--rounds 2] [--threads 1 2] [--no-append]
         [--model full|full-int8] [--detector float|int8] [--window-detector float|int8]
-        [--spin] [--search tiles|whole-frame]
+        [--spin] [--search tiles|whole-frame] [--people]
 
 The CPU-time goals are judged on the fastest choices, `--rounds 5 --model full-int8 --spin
 --window-detector int8` (`make bench` runs both; docs/benchmarks.md).
@@ -42,7 +48,7 @@ from bench.reference_env import ensure
 HERE = Path(__file__).resolve().parent
 
 ROOT = HERE.parent
-OURS, REF = "ours", "reference"
+OURS, PEOPLE, REF = "ours", "people", "reference"
 SHOULDERS, HIPS = (11, 12), (23, 24)
 FPS = 15.0
 TITLE = "Ours vs the reference pipeline (MediaPipe 0.10.14 + rule cascade)"
@@ -69,7 +75,7 @@ class Collected:
         return [r for r in self.runs if r.side == side and r.threads == threads]
 
     def sides(self) -> list[str]:
-        return [x for x in (OURS, REF) if any(r.side == x for r in self.runs)]
+        return [x for x in (OURS, PEOPLE, REF) if any(r.side == x for r in self.runs)]
 
 
 def worker_command(side: str, ref_python: Path) -> tuple[list[str], dict[str, str]]:
@@ -78,6 +84,8 @@ def worker_command(side: str, ref_python: Path) -> tuple[list[str], dict[str, st
     pure-Python modules from the checkout."""
     if side == OURS:
         return [sys.executable, "-m", "bench.pipeline_worker"], {}
+    if side == PEOPLE:
+        return [sys.executable, "-m", "bench.pipeline_worker", "--people"], {}
     return [str(ref_python), "-m", "bench.reference_worker"], {"GLOG_minloglevel": "2"}
 
 
@@ -99,8 +107,8 @@ def run_worker(
     cmd += ["--frames", str(frames), "--threads", str(threads), "--warmup", str(warmup)]
     # The reference runs MediaPipe's float model of the same complexity: full-int8 is a
     # quantisation of its full model.
-    cmd += ["--model", model if side == OURS else model.removesuffix("-int8")]
-    if side == OURS:  # the reference runs MediaPipe's own (float) detector
+    cmd += ["--model", model if side != REF else model.removesuffix("-int8")]
+    if side != REF:  # the reference runs MediaPipe's own (float) detector
         cmd += ["--runtime", runtime, "--detector", detector, "--search", search]
         if window_detector is not None:
             cmd += ["--window-detector", window_detector]
@@ -391,6 +399,47 @@ def error_table(
     return lines, worse
 
 
+def people_table(
+    col: Collected, threads: list[int], both: np.ndarray, rows: list[Row]
+) -> list[str]:
+    """Everyone's tracker against the one-pedestrian tracker, each to the reference from
+    the same runs: p50 on frames all sides found (the goal's figure), p50 and p95 on all
+    frames, and CPU-seconds per frame; `people/ours` is the change the people tracker
+    brings to each ratio."""
+    lines = [
+        "| threads | figure | ours/ref | people/ref | people/ours |",
+        "| --- | --- | ---: | ---: | ---: |",
+    ]
+    for t in threads:
+        figures: dict[str, dict[str, float]] = {}
+        for side in (OURS, PEOPLE, REF):
+            runs = col.of(side, t)
+            found = [r["ms"] for run in runs for r in run.rows if both[r["i"]]]
+            every = [r["ms"] for run in runs for r in run.rows]
+            cpu = float(np.median([r.summary["cpu_s"] / r.summary["frames"] for r in runs]))
+            figures[side] = {
+                "p50, frames all found": pct(found, 50),
+                "p50, all frames": pct(every, 50),
+                "p95, all frames": pct(every, 95),
+                "CPU-s per frame": cpu,
+            }
+        for name in figures[OURS]:
+            ours, people, ref = (figures[x][name] for x in (OURS, PEOPLE, REF))
+            rows.append(
+                {
+                    "threads": t,
+                    "figure": name,
+                    "ours_to_reference_x": ours / ref,
+                    "people_to_reference_x": people / ref,
+                    "people_to_ours_x": people / ours,
+                }
+            )
+            lines.append(
+                f"| {t} | {name} | {ours / ref:.2f} | {people / ref:.2f} | {people / ours:.2f} |"
+            )
+    return lines
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--rounds", type=int, default=2, help="ABBA rounds per thread count")
@@ -437,6 +486,12 @@ def main() -> None:
         help="our side's search while no one is tracked: the tile cascade that finds far "
         "pedestrians (default), or the whole frame only, as the reference searches",
     )
+    ap.add_argument(
+        "--people",
+        action="store_true",
+        help="a third side: ours following everyone in view (PeopleConfig()), beside the "
+        "one-pedestrian tracker, against the same reference runs",
+    )
     ap.add_argument("--no-append", action="store_true", help="do not write the history")
     args = ap.parse_args()
     from monopic.pose.sessions import runtime_unavailable
@@ -448,7 +503,7 @@ def main() -> None:
     npy, npz = build()
     fs = load(npy, npz)
     ref_python = ensure()
-    sides = (OURS, REF)
+    sides = (OURS, PEOPLE, REF) if args.people else (OURS, REF)
     col = Collected()
     start = time.perf_counter()
     loads = []
@@ -496,6 +551,7 @@ def main() -> None:
         "window_detector": args.window_detector,
         "spin": args.spin,
         "search": args.search,
+        "people": args.people,
         "load_min": min(loads),
         "load_max": max(loads),
         "latency": [],
@@ -518,6 +574,17 @@ def main() -> None:
                 f"({'meets' if o / f <= RATIO_GOAL else 'misses'} the <= {RATIO_GOAL} goal)"
             )
     errors, worse = error_table(fs, col, t0, results["landmark_error"])
+    versus: list[str] = []
+    if args.people:
+        results["people_vs_ours"] = []
+        versus = [
+            "",
+            "Everyone's tracker (people) against the one-pedestrian tracker (ours), each "
+            "to the reference in the same runs (< 1: faster; people/ours > 1: the people "
+            "tracker slower):",
+            "",
+            *people_table(col, args.threads, both, results["people_vs_ours"]),
+        ]
     seqs = ", ".join(fs.sequences)
     lines = [
         f"{n} frames 768x432 in {len(fs.sequences)} sequences ({seqs}); "
@@ -553,6 +620,7 @@ def main() -> None:
         "on rendered frames, not occluded):",
         "",
         *errors,
+        *versus,
         "",
         "Goal (whole frame p50 on frames all found): " + "; ".join(verdict) + ".",
         "Goal (landmark error equal or better, every group the interval can judge): "

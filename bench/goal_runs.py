@@ -93,9 +93,12 @@ def chosen(runs: list[BenchRun], args: argparse.Namespace) -> list[BenchRun]:
         "spin": args.spin,
         "runtime": "cpu",
         "search": "tiles",
+        # A run with the people side (--people): its "both found" frames are those all
+        # three sides found, not the two the goals are judged on.
+        "people": False,
     }
     defaults = {"model": "full", "detector": "float", "spin": False, "runtime": "cpu",
-                "search": "tiles", "window_detector": None}  # fmt: skip
+                "search": "tiles", "window_detector": None, "people": False}  # fmt: skip
     out = []
     for run in runs:
         r = run.results

@@ -4,12 +4,14 @@ The twin of bench/reference_worker.py; bench/compare_reference.py alternates the
 `threads` is the onnxruntime intra-op thread count of both models; with --pin the process
 is also confined to that many cores, as the reference is. The landmark stage is monopic's
 as shipped: the pruned landmark model and MediaPipe's heatmap refinement
-(monopic.pose.landmarks.refine_from_heatmap), as in the reference graph.
+(monopic.pose.landmarks.refine_from_heatmap), as in the reference graph. With --people
+the pipeline follows everyone in view (PipelineConfig.people = PeopleConfig()); the
+landmarks reported are those of the person whose warning is the robot's.
 
     .venv/bin/python -m bench.pipeline_worker --frames recordings/bench/frames-*.npy --threads 1
         [--model lite|full|heavy|full-int8] [--detector float|int8]
         [--window-detector float|int8] [--runtime cpu|openvino]
-        [--spin] [--search tiles|whole-frame]
+        [--spin] [--search tiles|whole-frame] [--people]
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ class OurRunner:
     def __init__(self, args: argparse.Namespace) -> None:
         from monopic.features.extractor import FeatureExtractor
         from monopic.frame import Frame
+        from monopic.people.tracker import PeopleConfig
         from monopic.pipeline import Pipeline, PipelineConfig
         from monopic.pose.tracker import TrackerConfig
 
@@ -49,11 +52,20 @@ class OurRunner:
                 else {}
             ),
         )
-        self.pipeline = Pipeline(PipelineConfig(tracker=config))
+        people = PeopleConfig() if args.people else None
+        self.pipeline = Pipeline(PipelineConfig(tracker=config, people=people))
 
     def reset(self) -> None:
+        """Forget the tracks at a sequence start without loading the models again (a new
+        Pipeline would, inside the timed pass): the tracker's state and each person's
+        features and last decisions, which would otherwise carry over to whoever gets
+        their identity in the next sequence."""
         self.pipeline.tracker.reset()
         self.pipeline.features = self._extractor()
+        if self.pipeline.people is not None:
+            self.pipeline.people.reset()
+            self.pipeline._extractors.clear()
+            self.pipeline._last.clear()
 
     def process(
         self, image: np.ndarray, timestamp: float, index: int
@@ -91,6 +103,9 @@ def options(ap: argparse.ArgumentParser) -> None:
         default="tiles",
         help="while no one is tracked: the tile cascade (ours) or the whole frame only "
         "(MediaPipe's way)",
+    )
+    ap.add_argument(
+        "--people", action="store_true", help="follow everyone in view (PeopleConfig())"
     )
 
 

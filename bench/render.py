@@ -31,6 +31,7 @@ ORDER = (
     "model_choices",
     "int8_landmarks",
     "pipeline_latency",
+    "people",
     "ncap_latency",
     "post_pose",
     "simulator",
