@@ -30,14 +30,12 @@ class OurRunner:
     """monopic.Pipeline with the reference rule cascade, image mode, no robot state."""
 
     def __init__(self, args: argparse.Namespace) -> None:
-        from monopic.features.extractor import FeatureExtractor
         from monopic.frame import Frame
         from monopic.people.tracker import PeopleConfig
         from monopic.pipeline import Pipeline, PipelineConfig
         from monopic.pose.tracker import TrackerConfig
 
         self._frame = Frame
-        self._extractor = FeatureExtractor
         config = TrackerConfig(
             threads=args.threads,
             model=args.model,
@@ -60,12 +58,7 @@ class OurRunner:
         Pipeline would, inside the timed pass): the tracker's state and each person's
         features and last decisions, which would otherwise carry over to whoever gets
         their identity in the next sequence."""
-        self.pipeline.tracker.reset()
-        self.pipeline.features = self._extractor()
-        if self.pipeline.people is not None:
-            self.pipeline.people.reset()
-            self.pipeline._extractors.clear()
-            self.pipeline._last.clear()
+        self.pipeline.reset()
 
     def process(
         self, image: np.ndarray, timestamp: float, index: int

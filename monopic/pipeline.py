@@ -162,12 +162,19 @@ class Pipeline:
         keys = [predictor_key(p) for p in self.predictors]
         if len(set(keys)) != len(keys):
             raise ValueError(f"predictors must differ by name or mode, got {keys}")
-        self.tracker = PoseTracker(self.config.tracker)
-        self.people = (
-            PeopleTracker(self.config.tracker, self.config.people)
-            if self.config.people is not None
-            else None
-        )
+        # One tracker or the other: each loads its own model sessions.
+        everyone = self.config.people is not None
+        self.tracker = None if everyone else PoseTracker(self.config.tracker)
+        self.people = PeopleTracker(self.config.tracker, self.config.people) if everyone else None
+        self.reset()
+
+    def reset(self) -> None:
+        """Forget everyone (a cut in the video, a new sequence) but keep the loaded models:
+        the tracks, and each person's features and last decisions, which would otherwise
+        pass to whoever gets their identity next."""
+        for tracker in (self.tracker, self.people):
+            if tracker is not None:
+                tracker.reset()
         self.features = self._extractor()
         self._extractors: dict[int, FeatureExtractor] = {}  # per person, everyone mode
         self._last: dict[int, tuple[float, tuple[Decision, ...]]] = {}  # their last decisions
@@ -192,6 +199,7 @@ class Pipeline:
         h, w = frame.image.shape[:2]
         timer = StageTimer()
         band = GroundBand.from_camera(frame.ego.camera) if frame.ego is not None else None
+        assert self.tracker is not None
         pose = self.tracker.process(frame.image, region, band, frame.timestamp)
         timer.lap("pose")
         feats = self.features.update(frame.timestamp, pose.pose, h, frame.ego)

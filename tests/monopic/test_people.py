@@ -238,3 +238,27 @@ def test_outputs_carry_each_person(tmp_path) -> None:
     entities = rows_per_entity(rrd)
     for person in result.people:
         assert entities[f"/camera/people/{person.person_id}/box"] > 0, entities
+
+
+def test_a_reset_pipeline_runs_a_sequence_again_as_the_first_time() -> None:
+    """reset() forgets the tracks and each person's features and last decisions: the
+    same frames give the same people, identities and warnings again."""
+    pipeline = Pipeline(PipelineConfig(people=PeopleConfig()))
+    assert pipeline.tracker is None  # the one-pedestrian tracker's sessions are not loaded
+    frames = _two_walkers()[:15]
+
+    def run() -> list:
+        out = []
+        for frame in frames:
+            r = pipeline.process(frame)
+            out.append(
+                [
+                    (p.person_id, p.box, p.warning and (p.warning.collision, p.warning.risk))
+                    for p in r.people
+                ]
+            )
+        return out
+
+    first = run()
+    pipeline.reset()
+    assert run() == first and any(len(people) == 2 for people in first)
