@@ -84,7 +84,7 @@ class ImageSequenceSource:
     def from_folder(cls, folder: Path, fps: float | None) -> ImageSequenceSource:
         """A MOTChallenge sequence: seqinfo.ini's [Sequence] names the image folder
         (imDir), the images' extension (imExt) and the frame rate (frameRate), which
-        is the sequence's and so wins over `fps`."""
+        is the sequence's: an `fps` that differs is refused."""
         info = folder / SEQINFO
         if not info.is_file():
             raise UserError(
@@ -92,7 +92,7 @@ class ImageSequenceSource:
                 f"{SEQINFO}; for other images give a pattern such as {folder / '%06d.jpg'}"
             )
         section = _sequence_section(info)
-        rate = _frame_rate(info, section)
+        rate = _rate(str(folder), _frame_rate(info, section), fps)
         images = folder / _field(info, section, "imDir")
         ext = _field(info, section, "imExt")
         if not images.is_dir():
@@ -147,7 +147,14 @@ def _read(file: Path) -> np.ndarray:
 
 
 def _rate(name: str, declared: float | None, fps: float | None) -> float:
+    """The sequence's frame rate: its seqinfo.ini's, else `fps`; an `fps` that differs
+    from the declared rate is refused (it would be ignored)."""
     if declared is not None:
+        if fps is not None and fps != declared:
+            raise UserError(
+                f"--fps {fps:g}: {name} declares its own frame rate, {declared:g} fps (its "
+                f"{SEQINFO}); --fps gives a rate only to images without one"
+            )
         return declared
     if fps is None:
         raise UserError(

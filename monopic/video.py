@@ -4,7 +4,8 @@ monopic.image_sequence).
 
 Velocities are computed from timestamps, never from an assumed frame rate: a file's
 frames carry the container's presentation times; a live camera's, the wall clock. A
-frame rate given by the user is used only where the file declares none.
+frame rate given by the user is used where the file declares none, and refused where it
+would be ignored.
 """
 
 from __future__ import annotations
@@ -28,13 +29,20 @@ class VideoSource:
 
     source: str
     ego: EgoState | None = None
-    fallback_fps: float | None = None  # the rate of a file that declares none
+    # The user's rate for a file that declares none (a file that declares another, or a
+    # camera, refuses it: it would be ignored).
+    fallback_fps: float | None = None
     # A frame's number as tracks files count them (index + first_number), as in an
     # image sequence, whose numbering starts at its first file's.
     first_number: int = 1
 
     def __post_init__(self) -> None:
         self.live = self.source.isdigit()
+        if self.live and self.fallback_fps is not None:
+            raise UserError(
+                f"--fps {self.fallback_fps:g}: camera {self.source}'s frames carry the wall "
+                "clock's time; --fps gives a rate only to inputs without one"
+            )
         if not self.live and not Path(self.source).is_file():
             raise UserError(f"{self.source}: no such video file")
         # FFmpeg would print its own diagnostics of a bad file; we report it in one line.
@@ -45,7 +53,13 @@ class VideoSource:
         self.width = int(self.capture.get(cv2.CAP_PROP_FRAME_WIDTH))
         self.height = int(self.capture.get(cv2.CAP_PROP_FRAME_HEIGHT))
         self.fps = float(self.capture.get(cv2.CAP_PROP_FPS) or 0.0)
-        if not (self.fps > 0) and self.fallback_fps is not None and not self.live:
+        if self.fallback_fps is not None:
+            if self.fps > 0 and self.fps != self.fallback_fps:
+                self.capture.release()
+                raise UserError(
+                    f"--fps {self.fallback_fps:g}: {self.source} declares its own frame rate, "
+                    f"{self.fps:g} fps; --fps gives a rate only to inputs without one"
+                )
             self.fps = self.fallback_fps
         count = int(self.capture.get(cv2.CAP_PROP_FRAME_COUNT))
         self.frame_count = count if count > 0 and not self.live else None

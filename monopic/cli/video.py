@@ -69,9 +69,9 @@ def register(sub: argparse._SubParsersAction) -> None:
         "--fps",
         type=positive_float,
         help="frame rate of an image pattern, which needs it unless it lies in a "
-        "MOTChallenge folder (> 0); a MOTChallenge folder keeps its seqinfo.ini frameRate, a "
-        "video file its own timestamps (--fps only where it declares no rate), a camera the "
-        "wall clock",
+        "MOTChallenge folder, or of a video file that declares none (> 0); refused where "
+        "the input has its own (a seqinfo.ini frameRate or a file's rate that differs, a "
+        "camera's wall clock)",
     )
     p.add_argument(
         "--variant",

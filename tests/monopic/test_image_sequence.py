@@ -70,7 +70,7 @@ def test_a_zero_padded_pattern_takes_only_names_printf_gives(tmp_path):
 
 def test_a_mot_folder_has_its_own_rate_and_first_number(tmp_path):
     folder = mot_folder(tmp_path / "seq", GOOD_INI)
-    for given in (None, 30.0):  # the folder's frameRate wins over --fps
+    for given in (None, 7.0):  # the folder's frameRate; --fps may only agree with it
         source = open_source(str(folder), given)
         assert (source.fps, source.first_number, source.frame_count) == (7.0, 1, 3)
         frames = list(source)
@@ -79,21 +79,39 @@ def test_a_mot_folder_has_its_own_rate_and_first_number(tmp_path):
         assert [int(f.image[0, 0, 2]) for f in frames] == [0, 10, 20]
 
 
+def test_an_fps_the_sequence_would_ignore_is_refused(tmp_path):
+    folder = mot_folder(tmp_path / "seq", GOOD_INI)
+    for text in (str(folder), str(folder / "img1" / "%06d.png")):
+        assert refusal(text, 30.0) == (
+            f"--fps 30: {text} declares its own frame rate, 7 fps (its seqinfo.ini); "
+            "--fps gives a rate only to images without one"
+        )
+
+
 def test_a_pattern_inside_a_mot_folder_takes_its_frame_rate(tmp_path):
     folder = mot_folder(tmp_path / "seq", GOOD_INI)
     source = open_source(str(folder / "img1" / "%06d.png"))
     assert (source.fps, source.first_number) == (7.0, 1)
 
 
-def test_a_video_file_keeps_its_own_rate_whatever_fps_says(tmp_path):
+def test_a_video_file_keeps_its_own_rate_and_refuses_another(tmp_path):
     clip = tmp_path / "c.mp4"
     w = cv2.VideoWriter(str(clip), cv2.VideoWriter_fourcc(*"mp4v"), 15, (64, 48))
     for _ in range(3):
         w.write(np.zeros((48, 64, 3), np.uint8))
     w.release()
-    source = open_source(str(clip), 30.0)
-    assert isinstance(source, VideoSource) and source.fps == 15.0
-    assert [round(f.timestamp * 15) for f in source] == [0, 1, 2]
+    for given in (None, 15.0):
+        source = open_source(str(clip), given)
+        assert isinstance(source, VideoSource) and source.fps == 15.0
+        assert [round(f.timestamp * 15) for f in source] == [0, 1, 2]
+    assert refusal(str(clip), 30.0) == (
+        f"--fps 30: {clip} declares its own frame rate, 15 fps; --fps gives a rate only "
+        "to inputs without one"
+    )
+    assert refusal("0", 30.0) == (
+        "--fps 30: camera 0's frames carry the wall clock's time; --fps gives a rate only "
+        "to inputs without one"
+    )
 
 
 class RatelessCapture:
