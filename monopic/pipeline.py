@@ -272,7 +272,7 @@ class Pipeline:
         for pid in [pid for pid in self._extractors if pid not in present]:
             del self._extractors[pid]  # gone: an identity never comes back
             self._last.pop(pid, None)
-        worst = _worst(people, self.primary)
+        worst = _worst(people)
         pose = PoseResult(
             worst.pose if worst is not None else None,
             seen.detector_runs,
@@ -289,7 +289,7 @@ class Pipeline:
 RISK_ORDER = {Risk.GREEN: 0, Risk.YELLOW: 1, Risk.RED: 2}
 
 
-def _worst(people: list[PersonResult], primary: str) -> PersonResult | None:
+def _worst(people: list[PersonResult]) -> PersonResult | None:
     """The person whose warning is the robot's: the highest risk, then the soonest
     collision, then a fresh decision over a carried one; people without any decision
     only when no one has one (then the first seen with a pose)."""

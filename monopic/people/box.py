@@ -52,13 +52,6 @@ def detection_box(det: Detection) -> Box:
     return around(float(hx), float(hy) - ABOVE_HIPS * r, float(hy) + BELOW_HIPS * r)
 
 
-def contains(box: Box, point: tuple[float, float], margin: float = 0.0) -> bool:
-    """Whether `point` lies in `box` grown by `margin` of its height on every side."""
-    m = margin * (box[3] - box[1])
-    x, y = point
-    return box[0] - m <= x <= box[2] + m and box[1] - m <= y <= box[3] + m
-
-
 def valid(box: Box) -> bool:
     return all(math.isfinite(v) for v in box) and box[2] > box[0] and box[3] > box[1]
 

@@ -208,7 +208,7 @@ class PeopleTracker:
                 continue
             if timestamp - person.last_seen > self.people.report_coast:
                 continue
-            box = pose_box(person.pose) if person.pose is not None else person.motion.current()
+            box = _box(person)
             sightings.append(
                 Sighting(person.person_id, box, person.motion.velocity, person.pose, person.seen)
             )
@@ -320,7 +320,7 @@ class PeopleTracker:
         keep = sorted(self._people, key=lambda p: (p.person_id is None, -p.hits))
         kept: list[_Person] = []
         for person in keep:
-            box = pose_box(person.pose) if person.pose is not None else person.motion.current()
+            box = _box(person)
             if any(iou(box, _box(k)) >= SAME_PERSON_IOU for k in kept):
                 continue
             if person.pose is not None and any(
@@ -349,6 +349,7 @@ def _around(box: Box, w: int, h: int) -> Window:
 
 
 def _box(person: _Person) -> Box:
+    """Where a person is this frame: their accepted pose's box, else their motion's."""
     return pose_box(person.pose) if person.pose is not None else person.motion.current()
 
 
