@@ -102,10 +102,19 @@ def authors_finite(row: list) -> bool:
 
 
 def mot_rows(r: FrameResult, frame_number: int) -> list[list]:
-    """The frame's lines of a MOTChallenge results file, one per person in view:
-    frame, id, bb_left, bb_top, bb_width, bb_height, conf, x, y, z (world unknown: -1)."""
+    """The frame's lines of a MOTChallenge results file, one per person in view."""
     return [
-        [frame_number, p.person_id, *(f"{v:.2f}" for v in _left_top_size(p.box)),
-         f"{p.pose.score:.3f}" if p.pose is not None else "1", -1, -1, -1]
+        mot_row(frame_number, p.person_id, p.box, p.pose.score if p.pose is not None else 1.0)
         for p in r.people
+    ]
+
+
+def mot_row(
+    frame_number: int, person_id: int, box: tuple[float, float, float, float], conf: float
+) -> list:
+    """One line of a MOTChallenge results file: frame, id, bb_left, bb_top, bb_width,
+    bb_height, conf, x, y, z (the world position unknown: -1)."""
+    return [
+        frame_number, person_id, *(f"{v:.2f}" for v in _left_top_size(box)), f"{conf:.3f}",
+        -1, -1, -1,
     ]  # fmt: skip

@@ -22,6 +22,7 @@ skips what is done; the summary table is printed and written to --out/summary.md
 from __future__ import annotations
 
 import argparse
+import csv
 import json
 import os
 from collections.abc import Iterator, Sequence
@@ -43,6 +44,7 @@ from monopic.evaluation.mot import (
     score_tracks,
 )
 from monopic.frame import Frame
+from monopic.framelog import mot_row
 from monopic.image_sequence import ImageSequenceSource
 from monopic.output import atomic_path
 from monopic.people.box import ABOVE_HIPS, BELOW_HIPS, HEAD_TOP, SOLE
@@ -191,14 +193,13 @@ def detector_recall(
 
 
 def write_tracks(path: Path, rows: Sequence[MotRow]) -> None:
-    with atomic_path(path) as tmp:
-        tmp.write_text(
-            "".join(
-                f"{r.frame},{r.identity},{r.box.left:.1f},{r.box.top:.1f},"
-                f"{r.box.width:.1f},{r.box.height:.1f},1,-1,-1,-1\n"
-                for r in rows
-            )
-        )
+    """The tracks as `monopic video --tracks` writes them."""
+    with atomic_path(path) as tmp, open(tmp, "w", newline="") as handle:
+        csv.writer(handle).writerows(
+            mot_row(r.frame, r.identity, (r.box.left, r.box.top, r.box.left + r.box.width,
+                                          r.box.top + r.box.height), r.conf)
+            for r in rows
+        )  # fmt: skip
 
 
 def _row(name: str, scores: TrackScores, spanning: int) -> str:
