@@ -3,6 +3,8 @@
 import subprocess
 import sys
 
+from tests.clips import tiny_clip
+
 
 def run(*args, cwd):
     return subprocess.run(
@@ -49,28 +51,9 @@ def test_unknown_variant_and_bad_horizon(tmp_path):
 
 
 def test_ground_mode_needs_camera_geometry(tmp_path):
-    import cv2
-    import numpy as np
-
-    clip = tmp_path / "c.mp4"
-    w = cv2.VideoWriter(str(clip), cv2.VideoWriter_fourcc(*"mp4v"), 15, (64, 48))
-    for _ in range(3):
-        w.write(np.zeros((48, 64, 3), np.uint8))
-    w.release()
+    clip = tiny_clip(tmp_path)
     r = run(str(clip), "--mode", "ground", cwd=tmp_path)
     assert r.returncode == 2 and "--fov" in r.stderr
-
-
-def tiny_clip(folder):
-    import cv2
-    import numpy as np
-
-    clip = folder / "c.mp4"
-    w = cv2.VideoWriter(str(clip), cv2.VideoWriter_fourcc(*"mp4v"), 15, (64, 48))
-    for _ in range(3):
-        w.write(np.zeros((48, 64, 3), np.uint8))
-    w.release()
-    return clip
 
 
 def test_no_output_asked_for_is_refused_before_any_frame(tmp_path):

@@ -12,6 +12,7 @@ import pytest
 from monopic.errors import UserError
 from monopic.image_sequence import ImageSequenceSource
 from monopic.video import VideoSource, open_source
+from tests.clips import tiny_clip
 from tests.paths import PETS09 as PETS
 
 
@@ -95,11 +96,7 @@ def test_a_pattern_inside_a_mot_folder_takes_its_frame_rate(tmp_path):
 
 
 def test_a_video_file_keeps_its_own_rate_and_refuses_another(tmp_path):
-    clip = tmp_path / "c.mp4"
-    w = cv2.VideoWriter(str(clip), cv2.VideoWriter_fourcc(*"mp4v"), 15, (64, 48))
-    for _ in range(3):
-        w.write(np.zeros((48, 64, 3), np.uint8))
-    w.release()
+    clip = tiny_clip(tmp_path)
     for given in (None, 15.0):
         source = open_source(str(clip), given)
         assert isinstance(source, VideoSource) and source.fps == 15.0
@@ -135,11 +132,7 @@ class RatelessCapture:
 def test_a_video_without_a_rate_takes_fps_and_is_refused_without(tmp_path, monkeypatch):
     import monopic.video
 
-    clip = tmp_path / "c.mp4"
-    w = cv2.VideoWriter(str(clip), cv2.VideoWriter_fourcc(*"mp4v"), 15, (64, 48))
-    for _ in range(3):
-        w.write(np.zeros((48, 64, 3), np.uint8))
-    w.release()
+    clip = tiny_clip(tmp_path)
     monkeypatch.setattr(monopic.video.cv2, "VideoCapture", RatelessCapture)
     source = open_source(str(clip), 4.0)
     assert source.fps == 4.0
