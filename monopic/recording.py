@@ -137,6 +137,20 @@ def encoded_jpeg(image: np.ndarray, quality: int = JPEG_QUALITY) -> rr.EncodedIm
     return rr.EncodedImage(contents=jpeg.tobytes(), media_type="image/jpeg")
 
 
+def skeleton_context(label: str, colour: tuple[int, int, int]) -> rr.AnnotationContext:
+    """BlazePose's 33 keypoints named and joined, so rerun draws points logged with
+    class 0 and keypoint ids as a labelled skeleton."""
+    return rr.AnnotationContext(
+        rr.ClassDescription(
+            info=rr.AnnotationInfo(id=0, label=label, color=colour),
+            keypoint_annotations=[
+                rr.AnnotationInfo(id=i, label=name) for i, name in enumerate(LANDMARK_NAMES)
+            ],
+            keypoint_connections=list(CONNECTIONS),
+        )
+    )
+
+
 class RunRecording(WholeOrNothing):
     """Writes one run to a .rrd file."""
 
@@ -158,15 +172,7 @@ class RunRecording(WholeOrNothing):
         self._warned = False  # the primary predictor's warning on the last processed frame
         if layout is not None:
             self.start(layout)
-        skeleton = rr.AnnotationContext(
-            rr.ClassDescription(
-                info=rr.AnnotationInfo(id=0, label="person", color=PIPELINE_COLOUR),
-                keypoint_annotations=[
-                    rr.AnnotationInfo(id=i, label=name) for i, name in enumerate(LANDMARK_NAMES)
-                ],
-                keypoint_connections=list(CONNECTIONS),
-            )
-        )
+        skeleton = skeleton_context("person", PIPELINE_COLOUR)
         self.rec.log("camera/pose", skeleton, static=True)
         self.rec.log("camera/people", skeleton, static=True)
         self._people: set[int] = set()  # identities with entities now

@@ -50,7 +50,7 @@ import rerun.blueprint as rrb
 
 from monopic.closing import WholeOrNothing
 from monopic.pipeline import FrameResult
-from monopic.pose.skeleton import CONNECTIONS, LANDMARK_NAMES
+from monopic.pose.skeleton import LANDMARK_NAMES
 from monopic.predict.base import Mode
 from monopic.recording import (
     FEATURE_COLOURS,
@@ -61,6 +61,7 @@ from monopic.recording import (
     image_bounds,
     panels,
     predictor_colour,
+    skeleton_context,
 )
 from monopic.variants.zone import swept_ground_zone
 from sim.recording.topdown import TopDownCamera
@@ -316,15 +317,7 @@ class SimRecording(WholeOrNothing):
             eye = world_eye(r.position, r.yaw, self._meeting_point(step))
             self.run.start(sim_blueprint(cam.width, cam.height, eye))
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
-        skeleton = rr.AnnotationContext(
-            rr.ClassDescription(
-                info=rr.AnnotationInfo(id=0, label="pedestrian", color=PEDESTRIAN_COLOUR),
-                keypoint_annotations=[
-                    rr.AnnotationInfo(id=i, label=name) for i, name in enumerate(LANDMARK_NAMES)
-                ],
-                keypoint_connections=list(CONNECTIONS),
-            )
-        )
+        skeleton = skeleton_context("pedestrian", PEDESTRIAN_COLOUR)
         rec.log("world/pedestrian", skeleton, static=True)
         self._log_road()
         robot = scenario.robot
