@@ -147,9 +147,9 @@ def _rendered(case: int, distance: float, frames: int, seed: int = 0):
         for step in world.run():
             assert step.frame is not None
             images.append(step.frame.image)
-            px = step.truth.landmarks_px
+            px = step.truth.pedestrian.landmarks_px
             lms.append(px)
-            vis.append(in_image(world.camera, px) & ~step.truth.landmarks_occluded)
+            vis.append(in_image(world.camera, px) & ~step.truth.pedestrian.landmarks_occluded)
             ts.append(step.time)
     return images, np.array(lms), np.array(vis), np.array(ts), sc.name
 

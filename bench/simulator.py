@@ -46,11 +46,16 @@ def scenario(
 
     from monopic.cases import Case
     from sim.scenario.cases import CasePlacement
+    from sim.scenario.lighting import PRESETS
     from sim.scenario.spec import Behaviour
 
     placement = CasePlacement(Case(case), duration=frames / REALTIME_FPS, seed=seed)
     sc = placement.scenario(behaviour=Behaviour(model=model))
-    return replace(sc, scene=replace(sc.scene, shadows=shadows))
+    if shadows:
+        return sc
+    sun = sc.scene.lighting.sun  # the same sun behind clouds
+    overcast = PRESETS["overcast"].with_sun(sun.azimuth_deg, sun.elevation_deg)
+    return replace(sc, scene=replace(sc.scene, lighting=overcast))
 
 
 def child_render(frames: int) -> dict[str, Any]:

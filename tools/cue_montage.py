@@ -98,10 +98,12 @@ def render_row(row: Row) -> np.ndarray:
                 step = world.step()
             assert step is not None and step.frame is not None
             state = world.pedestrian.state  # type: ignore[union-attr]
-            tile = crop(cv2.cvtColor(step.frame.image, cv2.COLOR_RGB2BGR), step.truth.box)
+            tile = crop(
+                cv2.cvtColor(step.frame.image, cv2.COLOR_RGB2BGR), step.truth.pedestrian.box
+            )
             label = (
                 f"t {step.time:.2f} s  v {state.speed:.2f}",
-                f"head {math.degrees(step.truth.head_yaw_shoulders):+.0f}  "
+                f"head {math.degrees(step.truth.pedestrian.head_yaw_shoulders):+.0f}  "
                 f"shoulders {math.degrees(state.torso_yaw):+.0f} deg",
             )
             for k, text in enumerate(label):

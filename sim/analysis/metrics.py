@@ -190,6 +190,7 @@ class RunOutcome:
     frames: FrameCounts
     behaviour: str = "rail"  # the pedestrian's walker model
     cues: bool = False  # whether it showed intent cues
+    lighting: str = ""  # the lighting preset (sim.scenario.lighting)
     nuisance_onsets: int = 0  # warning onsets while no contact is ahead at all
     clear_seconds: float = 0.0  # s in view with no contact ahead (the nuisance exposure)
     episodes: int = 0  # warning episodes (runs of warned frames)
@@ -312,6 +313,7 @@ def judge_run(row: RunResult, method: str) -> RunOutcome:
         frames=counts,
         behaviour=scenario.behaviour,
         cues=scenario.cues,
+        lighting=scenario.lighting,
         nuisance_onsets=sum(clear[k] for k in onsets),
         clear_seconds=sum(clear) * scenario.dt,
         episodes=len(onsets),
@@ -766,6 +768,7 @@ class SweepMetrics:
     codes: tuple[str, ...] = ()  # sim.runs.code_version of the runs ("unknown" before it existed)
     # method -> (walker model, "cues" or "no cues") -> summary
     by_behaviour: dict[str, dict[tuple[str, str], WarningSummary]] = field(default_factory=dict)
+    by_lighting: dict[str, dict[str, WarningSummary]] = field(default_factory=dict)  # preset
     intents: dict[str, IntentSummary] = field(default_factory=dict)  # methods stating one
 
 
@@ -799,6 +802,7 @@ def compute(rows: Sequence[RunResult]) -> SweepMetrics:
         by_speed=grouped(lambda o: round(o.robot_speed, 2)),
         by_scale=grouped(lambda o: o.scale),
         by_behaviour=grouped(lambda o: (o.behaviour, "cues" if o.cues else "no cues")),
+        by_lighting=grouped(lambda o: o.lighting),
         cases={m: case_summary(rows, m) for m in all_methods},
         positions={m: position_summary(rows, m) for m in all_methods},
         phi={p: phi_summary(rows, p) for p in pipelines},

@@ -8,9 +8,10 @@ never holds a half-written report.
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 from monopic.cases import Case
 from monopic.output import write_text_atomically
@@ -98,18 +99,23 @@ class Report:
     headline: str
 
 
-def behaviour_rows(m: SweepMetrics, methods: Sequence[str]) -> list[list[str]]:
-    """Per walker model and cue setting, per method: what a safety engineer asks first."""
+def group_rows(
+    groups: dict[str, dict[Any, WarningSummary]],
+    methods: Sequence[str],
+    label: Callable[[Any], str],
+) -> list[list[str]]:
+    """Per group (a walker model, a lighting preset...), per method: what a safety engineer
+    asks first."""
     rows = []
-    groups = sorted({g for method in methods for g in m.by_behaviour.get(method, {})})
-    for group in groups:
+    keys = sorted({g for method in methods for g in groups.get(method, {})})
+    for key in keys:
         for method in methods:
-            s = m.by_behaviour[method].get(group)
+            s = groups[method].get(key)
             if s is None:
                 continue
             rows.append(
                 [
-                    f"{group[0]}, {group[1]}",
+                    label(key),
                     method,
                     str(s.runs),
                     _recall(s, s.warned_1s, s.recall_1s_low),
@@ -122,6 +128,17 @@ def behaviour_rows(m: SweepMetrics, methods: Sequence[str]) -> list[list[str]]:
                 ]
             )
     return rows
+
+
+GROUP_COLUMNS = (
+    "method",
+    "runs",
+    f"recall@{LEAD_GOAL:g}s",
+    "lead p50",
+    "near misses warned",
+    "nuisance warnings / h",
+    "flicker",
+)
 
 
 def family_goal_rows(m: SweepMetrics, methods: Sequence[str]) -> list[list[str]]:
@@ -311,18 +328,16 @@ def write_report(
         f"{FLICKER_S:g} s of ending, as a share of warning episodes.",
         "",
         *table(
-            [
-                "walker",
-                "method",
-                "runs",
-                f"recall@{LEAD_GOAL:g}s",
-                "lead p50",
-                "near misses warned",
-                "nuisance warnings / h",
-                "flicker",
-            ],
-            behaviour_rows(m, main_methods),
-        ),  # fmt: skip
+            ["walker", *GROUP_COLUMNS],
+            group_rows(m.by_behaviour, main_methods, lambda g: f"{g[0]}, {g[1]}"),
+        ),
+        "",
+        "## By lighting",
+        "",
+        "The lighting preset of each run (sim/scenario/lighting.py; a file that moves the sun",
+        "keeps its preset's name). Columns as above.",
+        "",
+        *table(["lighting", *GROUP_COLUMNS], group_rows(m.by_lighting, main_methods, str)),
         "",
         "## Ablation: real pose vs ground-truth crop",
         "",

@@ -102,7 +102,9 @@ def dataset_pipeline(scenario: Scenario) -> Pipeline:
 def keypoints33(truth: GroundTruth, width: int, height: int) -> list[float]:
     """Flat COCO [x, y, v] * 33: v 0 outside the image (x = y = 0), 1 occluded, 2 in view."""
     out: list[float] = []
-    for (u, v), hidden in zip(truth.landmarks_px, truth.landmarks_occluded, strict=True):
+    for (u, v), hidden in zip(
+        truth.pedestrian.landmarks_px, truth.pedestrian.landmarks_occluded, strict=True
+    ):
         if not (math.isfinite(u) and math.isfinite(v) and 0 <= u < width and 0 <= v < height):
             out += [0, 0, 0]
         else:
@@ -113,7 +115,7 @@ def keypoints33(truth: GroundTruth, width: int, height: int) -> list[float]:
 def _truth_line(run: DatasetRun, frame: int, image: str, mask: str, truth: GroundTruth) -> str:
     row = {"run": run.id, "frame": frame, "image": image, "mask": mask}
     row.update(truth.to_dict())
-    row["case_name"] = truth.case.label
+    row["case_name"] = truth.pedestrian.case.label
     return json.dumps(row, separators=(",", ":"), default=_plain)
 
 
@@ -177,7 +179,7 @@ class FrameWriter(Listener):
         )
         area = int(mask.sum())
         if area > 0:
-            u0, v0, u1, v1 = truth.box
+            u0, v0, u1, v1 = truth.pedestrian.box
             self.annotations.append(
                 {
                     "id": image_id,
@@ -189,8 +191,8 @@ class FrameWriter(Listener):
                     "amodal_bbox": _clipped_box(u0, v0, u1, v1, cam.width, cam.height),
                     "segmentation": encode_mask(mask),
                     "keypoints33": keypoints33(truth, cam.width, cam.height),
-                    "case": int(truth.case),
-                    "occluded": bool(truth.occluded),
+                    "case": int(truth.pedestrian.case),
+                    "occluded": bool(truth.pedestrian.occluded),
                 }
             )
         self.truth_lines.append(_truth_line(run, k, image_name, mask_name, truth))

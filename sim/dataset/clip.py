@@ -90,12 +90,14 @@ def walk(clip: ClipSpec, scene: Scene) -> Iterator[tuple[int, float]]:
     n_frames = int(round(clip.duration * clip.fps))
     x = clip.robot_x + clip.distance
     phase = 0.0
+    person = scene.pedestrians[0]
     for k in range(n_frames):
         t = k / clip.fps
         y = clip.robot_y + clip.start_offset - clip.speed * t
-        scene.set_pedestrian(x, y, -math.pi / 2, gait_phase=phase, speed=clip.speed)
+        person.pose_at(scene.model, scene.data, x, y, -math.pi / 2, phase, clip.speed)
+        scene.update()
         yield k, t
-        phase = scene.gait.advance(phase, clip.speed, 1.0 / clip.fps)
+        phase = person.gait.advance(phase, clip.speed, 1.0 / clip.fps)
 
 
 def render_clip(
@@ -125,7 +127,8 @@ def render_clip(
                     writer.write(bgr)
                     if frames_dir is not None:
                         cv2.imwrite(str(frames_dir / f"frame_{k:03d}.png"), bgr)
-                    out.writerow(truth_row(k, t, scene.truth()))
+                    body = scene.pedestrians[0].seen(scene.data, scene.camera, scene.robot_pose)
+                    out.writerow(truth_row(k, t, body))
         finally:
             writer.release()
     return times

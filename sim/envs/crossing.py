@@ -244,7 +244,10 @@ class PedestrianCrossingEnv(AbstractEnv):
         self.enable_auto_render = False
 
     def _rewards(self, action: object) -> dict[str, float]:
-        return {"progress": self._progress, "contact": float(self.world_step.truth.contact)}
+        return {
+            "progress": self._progress,
+            "contact": float(self.world_step.truth.pedestrian.contact),
+        }
 
     def _reward(self, action: object) -> float:
         r = self._rewards(action)
@@ -260,7 +263,7 @@ class PedestrianCrossingEnv(AbstractEnv):
         )
 
     def _is_terminated(self) -> bool:
-        return bool(self.world_step.truth.contact or self._pedestrian_passed())
+        return bool(self.world_step.truth.pedestrian.contact or self._pedestrian_passed())
 
     def _is_truncated(self) -> bool:
         """At the scenario's duration, counted in frames (Scenario.frames) like World.run."""
@@ -271,7 +274,7 @@ class PedestrianCrossingEnv(AbstractEnv):
         return {
             "time": step.time,
             "speed": step.ego.speed,
-            "crashed": step.truth.contact,
+            "crashed": step.truth.pedestrian.contact,
             "action": float(self.action_type.last_action),  # normalised, [-1, 1]
             "acceleration": float(self.action_type.acceleration),  # m/s^2
             "rewards": self._rewards(action),

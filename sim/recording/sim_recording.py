@@ -302,7 +302,7 @@ class SimRecording(WholeOrNothing):
         start = np.asarray(r.position, dtype=float)[:2]
         path = self.world.pedestrian.path if self.world.pedestrian else None
         if path is None:
-            return np.asarray(step.truth.position_world, dtype=float)[:2]
+            return np.asarray(step.truth.pedestrian.position_world, dtype=float)[:2]
         ahead = np.array([math.cos(r.yaw), math.sin(r.yaw)])
         times = np.linspace(0.0, scenario.duration, max(2, int(scenario.duration * 20) + 1))
         peds = np.array([path.state(float(t)).position for t in times])[:, :2]
@@ -441,7 +441,7 @@ class SimRecording(WholeOrNothing):
         self.run.set_time(step.index, step.time)
         if step.frame is not None:
             self.run.log_image(step.frame.image)
-        self._colliding_now = truth.collision
+        self._colliding_now = truth.pedestrian.collision
         if result is not None:
             self.primary = self.primary or result.primary
             self.run.log_result(result)
@@ -455,7 +455,7 @@ class SimRecording(WholeOrNothing):
                 self._topdown = TopDownCamera(self.world)
             rec.log("topdown/image", encoded_jpeg(self._topdown.render()))
         self.frames += 1
-        self.collision_frames += int(truth.collision)
+        self.collision_frames += int(truth.pedestrian.collision)
 
     def log_event(self, text: str, level: str = rr.TextLogLevel.INFO) -> None:
         """A line in the events view at the current frame (e.g. the closed loop's brake)."""
@@ -527,20 +527,20 @@ class SimRecording(WholeOrNothing):
     def _log_camera_truth(self, truth: GroundTruth) -> None:
         rec = self.rec
         camera = self.world.camera
-        foot = truth.foot_px
-        if truth.in_frame and np.all(np.isfinite(foot)):
+        foot = truth.pedestrian.foot_px
+        if truth.pedestrian.in_frame and np.all(np.isfinite(foot)):
             rec.log(
                 "camera/truth/foot",
                 rr.Points2D([foot], colors=[TRUTH_COLOUR], radii=-5.0, labels=["truth"]),
             )
             rec.log(
                 "camera/truth/centre",
-                rr.Points2D([truth.centre_px], colors=[TRUTH_COLOUR], radii=-3.0),
+                rr.Points2D([truth.pedestrian.centre_px], colors=[TRUTH_COLOUR], radii=-3.0),
             )
             rec.log(
                 "camera/truth/box",
                 rr.Boxes2D(
-                    array=np.array(truth.box),
+                    array=np.array(truth.pedestrian.box),
                     array_format=rr.Box2DFormat.XYXY,
                     colors=[TRUTH_COLOUR],
                 ),
@@ -565,8 +565,10 @@ class SimRecording(WholeOrNothing):
         """World (x, y) of the true path from now to now + horizon."""
         path = self.world.pedestrian.path if self.world.pedestrian else None
         if path is None:
-            return np.array([truth.position_world, truth.future_position_world])
-        times = truth.time + np.linspace(0.0, truth.horizon, PATH_SAMPLES)
+            return np.array(
+                [truth.pedestrian.position_world, truth.pedestrian.future_position_world]
+            )
+        times = truth.time + np.linspace(0.0, truth.pedestrian.horizon, PATH_SAMPLES)
         return np.array([path.state(float(t)).position for t in times])
 
     def _log_world(self, step: WorldStep) -> None:
@@ -598,7 +600,7 @@ class SimRecording(WholeOrNothing):
         rec.log(
             "world/pedestrian",
             rr.Points3D(
-                truth.body.landmarks_world,
+                truth.pedestrian.body.landmarks_world,
                 class_ids=0,
                 keypoint_ids=np.arange(len(LANDMARK_NAMES)),
                 radii=0.025,
@@ -626,29 +628,34 @@ class SimRecording(WholeOrNothing):
 
     def _log_series(self, truth: GroundTruth) -> None:
         rec = self.rec
-        rec.log("truth/phi", rr.Scalars(truth.phi))
-        rec.log("truth/head_yaw", rr.Scalars(math.degrees(truth.head_yaw_shoulders)))
-        if truth.time_to_collision is not None:
-            rec.log("ttc/truth", rr.Scalars(truth.time_to_collision))
-        rec.log("alarm/truth", rr.Scalars(float(truth.collision)))
+        rec.log("truth/phi", rr.Scalars(truth.pedestrian.phi))
+        rec.log("truth/head_yaw", rr.Scalars(math.degrees(truth.pedestrian.head_yaw_shoulders)))
+        if truth.pedestrian.time_to_collision is not None:
+            rec.log("ttc/truth", rr.Scalars(truth.pedestrian.time_to_collision))
+        rec.log("alarm/truth", rr.Scalars(float(truth.pedestrian.collision)))
         self._lane(
-            "alarm/truth", CONTACT if truth.contact else COURSE if truth.collision else CLEAR
+            "alarm/truth",
+            CONTACT
+            if truth.pedestrian.contact
+            else COURSE
+            if truth.pedestrian.collision
+            else CLEAR,
         )
         rec.log("robot/speed", rr.Scalars(truth.robot.speed))
         rec.log("truth/gap", rr.Scalars(footprint_gap(truth, self.scenario.pedestrian.footprint)))
 
     def _log_events(self, step: WorldStep, result: FrameResult | None) -> None:
         truth = step.truth
-        if truth.collision and not self._was_colliding and not truth.contact:
-            ttc = truth.time_to_collision
+        if truth.pedestrian.collision and not self._was_colliding and not truth.pedestrian.contact:
+            ttc = truth.pedestrian.time_to_collision
             self.log_event(
                 f"truth: on a collision course, contact in {ttc:.2f} s"
                 if ttc is not None
                 else "truth: on a collision course",
                 rr.TextLogLevel.WARN,
             )
-        self._was_colliding = truth.collision
-        if truth.contact and not self._contact_logged:
+        self._was_colliding = truth.pedestrian.collision
+        if truth.pedestrian.contact and not self._contact_logged:
             self.contact_time = truth.time
             self._contact_logged = True
             self.log_event(

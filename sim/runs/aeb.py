@@ -131,7 +131,7 @@ class AebController:
             self.warned_frames += 1
             if self.first_warning_frame is None:
                 self.first_warning_frame = frame.index
-                ttc = frame.truth.time_to_collision  # at constant speeds, as NCAP's TTC
+                ttc = frame.truth.pedestrian.time_to_collision  # at constant speeds, as NCAP's TTC
                 self.warning_ttc = None if ttc is None else max(0.0, float(ttc) - latency)
         self.brake.observe(frame.truth.time, warned, latency)
         return self.brake.action(frame.truth.time)
@@ -203,7 +203,7 @@ def run_aeb(
     robot, footprint = scenario.robot, scenario.pedestrian.footprint
 
     def over(step: WorldStep) -> bool:
-        if step.truth.contact:
+        if step.truth.pedestrian.contact:
             return False
         passed = pedestrian_passed(step.truth, robot.length, footprint)
         stopped = step.truth.robot.speed <= 0.0 and brake.brake_start is not None
@@ -220,7 +220,7 @@ def run_aeb(
             end = run_loop(
                 world, onboard, listeners, controller=controller, until=over, seed=world_seed(seed)
             )
-        ped_speed = float(end.final.truth.velocity_robot[0])
+        ped_speed = float(end.final.truth.pedestrian.velocity_robot[0])
     latency.check_used()
     start = log.start_speed if log.start_speed is not None else robot.speed
     contact = log.contact_time is not None

@@ -176,7 +176,7 @@ class BrakeController:
             warned = bool(result.warning is not None and result.warning.collision)
             latency = self.latency.next_ms(result.stage_ms["total"]) / 1e3
         elif self.policy == ORACLE:
-            warned = truth.collision
+            warned = truth.pedestrian.collision
             fixed = self.latency.latency_ms
             latency = 0.0 if fixed is None else fixed / 1e3
         else:
@@ -208,7 +208,7 @@ class LoopLog(Listener):
         if self.start_speed is None:
             self.start_speed = truth.robot.speed
         self.min_gap = min(self.min_gap, footprint_gap(truth, self.footprint))
-        if truth.contact and self.contact_time is None:
+        if truth.pedestrian.contact and self.contact_time is None:
             self.contact_time, self.impact_speed = truth.time, truth.robot.speed
         if self.recording is not None:
             self.recording.log_step(frame.step, frame.results.get(POLICY))
@@ -258,7 +258,7 @@ def run_closed_loop(
     robot, footprint = scenario.robot, scenario.pedestrian.footprint
 
     def over(step: WorldStep) -> bool:  # as the gymnasium environment ends an episode
-        if step.truth.contact:
+        if step.truth.pedestrian.contact:
             return False  # a contact frame is processed, then the loop stops
         passed = pedestrian_passed(step.truth, robot.length, footprint)
         return passed or step.index >= scenario.frames

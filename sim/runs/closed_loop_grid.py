@@ -229,6 +229,7 @@ def work(spec: LoopRun, kept: KeptRenderContext | None = None) -> dict[str, Any]
             "source": spec.source.to_json(),
             "scenario": spec.scenario.name,
             "family": spec.scenario.family,
+            "lighting": spec.scenario.scene.lighting.name,
             "policy": spec.policy,
             "seed": spec.scenario.seed,
             "latency": spec.latency.to_json(),

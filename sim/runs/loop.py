@@ -149,10 +149,10 @@ def run_loop(
         for listener in listeners:
             listener.frame(frame)
         processed += 1
-        if step.truth.contact and contact_time is None:
+        if step.truth.pedestrian.contact and contact_time is None:
             contact_time = step.truth.time
         reason = ""
-        if step.truth.contact and stop_at_contact:
+        if step.truth.pedestrian.contact and stop_at_contact:
             reason = "contact"
         elif frames is not None and processed >= frames:
             reason = "frames"

@@ -169,6 +169,7 @@ def _run(protocol: Protocol, car: CarSpec, policy: str, key: str, role: str, k: 
     rid = f"{policy}/{key}/{role}{k}-{run_digest(s, aeb)}"
     # The files a rerun rebuilds the run from (sim.runs.rebuild), as the command was given them.
     meta = {**meta, "protocol": str(protocol.path), "car": str(car.path)}
+    meta["lighting"] = s.scene.lighting.name
     return NcapRun(rid, replace(s, name=rid), policy, aeb, role, k, meta, latency=latency)
 
 

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 from typing import Any, Union, get_args, get_origin, get_type_hints
 
 from monopic.errors import UserError
+from sim.scenario.lighting import DAY, FILE_DEFAULT
 
 SCHEMA = 1
 MAIN = "main"  # the real pipeline: it finds the person itself
@@ -120,6 +121,8 @@ class ScenarioSummary:
     occluders: int
     behaviour: str = "rail"  # the pedestrian's walker model (lines before it: rail)
     cues: bool = False  # whether the walker shows intent cues (head checks, leads)
+    # The lighting preset (sim.scenario.lighting); lines before it: _lighting_of_old_lines.
+    lighting: str = ""
 
 
 @dataclass
@@ -189,7 +192,8 @@ class RunResult:
                 f"({'written by newer code: update this checkout' if newer else 'rerun the sweep'}"
                 " or rerun with `monopic sweep SPEC --restart`)"
             )
-        return _behaviour_of_old_lines(_current_names(from_plain(cls, data, where)), data)
+        result = _current_names(from_plain(cls, data, where))
+        return _lighting_of_old_lines(_behaviour_of_old_lines(result, data))
 
     def dumps(self) -> str:
         """One compact JSON line (no newline)."""
@@ -226,6 +230,20 @@ def _behaviour_of_old_lines(result: RunResult, data: dict[str, Any]) -> RunResul
         model = result.params.get("pedestrian.behaviour.model")
         if isinstance(model, str):
             result.scenario.behaviour = model
+    return result
+
+
+def _lighting_of_old_lines(result: RunResult) -> RunResult:
+    """Lines written before results named their lighting: the preset the sweep set (its
+    params), else the one their scenario had: a file's default when the run came from a
+    file, the code's sun when it was built in code. (A family file that chose a lighting
+    without sweeping it would be misread as noon; none of the shipped ones does.)"""
+    if not result.scenario.lighting:
+        swept = result.params.get("scene.lighting")
+        if isinstance(swept, str):
+            result.scenario.lighting = swept
+        else:
+            result.scenario.lighting = FILE_DEFAULT if result.file else DAY.name
     return result
 
 

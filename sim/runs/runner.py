@@ -44,12 +44,12 @@ SHOULDER_LANDMARKS = (11, 12)
 
 def truth_region(truth: GroundTruth) -> Region | None:
     """The true crop, as MediaPipe would align it: centred on the hips, along the body axis."""
-    if not truth.in_frame:
+    if not truth.pedestrian.in_frame:
         return None
-    px = truth.landmarks_px
+    px = truth.pedestrian.landmarks_px
     hip = px[list(HIP_LANDMARKS)].mean(axis=0)
     shoulder = px[list(SHOULDER_LANDMARKS)].mean(axis=0)
-    height = truth.apparent_height
+    height = truth.pedestrian.apparent_height
     axis = shoulder - hip
     norm = float(np.linalg.norm(axis))
     if not (np.all(np.isfinite(hip)) and math.isfinite(height) and height > 4 and norm > 0):
@@ -82,6 +82,7 @@ def scenario_summary(s: Scenario) -> ScenarioSummary:
         occluders=len(s.scene.occluders),
         behaviour=s.pedestrian.behaviour.model,
         cues=s.pedestrian.behaviour.cues,
+        lighting=s.scene.lighting.name,
     )
 
 

@@ -1,4 +1,4 @@
-"""What a scenario family means: robot presets, looks, lighting, and NCAP-style placement.
+"""What a scenario family means: robot presets, looks, and NCAP-style placement.
 
 Euro NCAP's pedestrian tests put the pedestrian so that, if nobody brakes, the front of
 the vehicle strikes them at a chosen point across its width at a chosen time. Here that
@@ -84,17 +84,6 @@ CAR = ScalePreset(
 )
 
 SCALES: dict[Scale, ScalePreset] = {Scale.CAR: CAR, Scale.SMALL: SMALL}
-
-# Sun positions (azimuth CCW from east where the light comes from, elevation), degrees.
-# The robot drives east, so azimuth 0 is a low sun straight ahead (backlit pedestrians).
-LIGHTING: dict[str, tuple[float, float]] = {
-    "noon": (210.0, 60.0),
-    "morning": (120.0, 25.0),
-    "low-sun-behind": (180.0, 10.0),
-    "low-sun-ahead": (15.0, 10.0),
-    "overcast": (210.0, 60.0),  # the sun behind clouds: diffuse light, no cast shadows
-}
-SHADOWLESS = frozenset({"overcast"})
 
 BODIES = ("adult", "child")
 

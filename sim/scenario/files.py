@@ -28,9 +28,7 @@ from sim.scenario.families import (
     CLOTHING,
     HESITATE_SPEED,
     HESITATE_TIME,
-    LIGHTING,
     SCALES,
-    SHADOWLESS,
     Crossing,
     Longitudinal,
     PlacementError,
@@ -46,6 +44,8 @@ from sim.scenario.families import (
     place_turn_in,
     street_bounds,
 )
+from sim.scenario.lighting import FILE_DEFAULT, Lighting
+from sim.scenario.lighting import PRESETS as LIGHTING
 from sim.scenario.path import pedestrian_path
 from sim.scenario.spec import (
     BEHAVIOURS,
@@ -385,9 +385,9 @@ def scene_data(scene: SceneSpec) -> dict[str, Any]:
     """[scene] of a scenario file that builds `scene` (its occluders aside)."""
     road = scene.road
     return {
-        "sun_azimuth_deg": scene.sun_azimuth_deg,
-        "sun_elevation_deg": scene.sun_elevation_deg,
-        "lighting": "noon" if scene.shadows else "overcast",
+        "lighting": scene.lighting.name,
+        "sun_azimuth_deg": scene.lighting.sun.azimuth_deg,
+        "sun_elevation_deg": scene.lighting.sun.elevation_deg,
         "road": {
             "length": road.length,
             "lanes": road.lanes,
@@ -482,13 +482,7 @@ def build(path: Path, data: Mapping[str, Any]) -> Scenario:
     )
     occluders = _parked_cars(top.table("scene").table("parked_cars"), x_line, robot, road)
     top.done()
-    scene = SceneSpec(
-        occluders=occluders,
-        road=road,
-        sun_azimuth_deg=lighting[0],
-        sun_elevation_deg=lighting[1],
-        shadows=lighting[2],
-    )
+    scene = SceneSpec(occluders=occluders, road=road, lighting=lighting)
     scenario = Scenario(
         name=name,
         pedestrian=pedestrian,
@@ -598,11 +592,14 @@ def _camera(t: TomlTable, preset: CameraSpec) -> CameraSpec:
     return camera
 
 
-def _scene(t: TomlTable, preset: RoadLayout) -> tuple[RoadLayout, tuple[float, float, bool]]:
-    lighting = t.text("lighting", "noon", tuple(LIGHTING))
-    azimuth, elevation = LIGHTING[lighting]
-    azimuth = t.number("sun_azimuth_deg", azimuth, low=-360.0, high=360.0, unit="degrees")
-    elevation = t.number("sun_elevation_deg", elevation, low=2.0, high=90.0, unit="degrees")
+def _scene(t: TomlTable, preset: RoadLayout) -> tuple[RoadLayout, Lighting]:
+    light = LIGHTING[t.text("lighting", FILE_DEFAULT, tuple(LIGHTING))]
+    azimuth = t.number(
+        "sun_azimuth_deg", light.sun.azimuth_deg, low=-360.0, high=360.0, unit="degrees"
+    )
+    elevation = t.number(
+        "sun_elevation_deg", light.sun.elevation_deg, low=2.0, high=90.0, unit="degrees"
+    )
     r = t.table("road")
     crosswalk = r.flag("crosswalk", preset.crosswalk_x is not None)
     crosswalk_x = r.number("crosswalk_x", preset.crosswalk_x or 12.0, unit="m")
@@ -627,7 +624,7 @@ def _scene(t: TomlTable, preset: RoadLayout) -> tuple[RoadLayout, tuple[float, f
     r.done()
     t.seen.add("parked_cars")  # read by _parked_cars once the path is known
     t.done()
-    return road, (azimuth, elevation, lighting not in SHADOWLESS)
+    return road, light.with_sun(azimuth, elevation)
 
 
 def _path(

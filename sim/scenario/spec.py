@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from monopic.camera import CameraModel
 from monopic.cases import Case
 from monopic.variants.zone import RobotGeometry
+from sim.scenario.lighting import DAY, Lighting
 
 RGB = tuple[float, float, float]
 
@@ -272,9 +273,7 @@ class PedestrianSpec:
 @dataclass(frozen=True)
 class SceneSpec:
     occluders: tuple[Occluder, ...] = ()  # e.g. Occluder.parked_car(x, y)
-    sun_azimuth_deg: float = 210.0
-    sun_elevation_deg: float = 50.0
-    shadows: bool = True  # False: an overcast sky, diffuse light and no cast shadows
+    lighting: Lighting = DAY  # sky and sun (sim.scenario.lighting: the presets)
     road: RoadLayout = field(default_factory=RoadLayout)  # the street (MuJoCo and highway-env)
 
 

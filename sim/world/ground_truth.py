@@ -1,7 +1,8 @@
 """Ground truth per frame: what the simulator knows that the pipeline must find out.
 
-Assembled by World from highway-env's objects (robot, pedestrian path, footprints) and the
-posed MuJoCo mannequin (sim.world.body.PedestrianTruth). Conventions:
+Each entity tells its own (sim.world.entities: the robot its RobotState, each pedestrian
+a PersonTruth from highway-env's objects and its posed mannequin) and World composes them
+into the frame's GroundTruth. Conventions:
 
 - world frame as in sim.geometry.frames; robot frame as in monopic.camera (x forward, y left),
   taken at this frame's robot pose;
@@ -32,7 +33,8 @@ posed MuJoCo mannequin (sim.world.body.PedestrianTruth). Conventions:
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from collections.abc import Mapping
+from dataclasses import dataclass, field
 
 import mujoco
 import numpy as np
@@ -84,12 +86,10 @@ class RobotState:
 
 
 @dataclass(frozen=True)
-class GroundTruth:
-    """Everything true about the pedestrian and the robot at one frame."""
+class PersonTruth:
+    """Everything true about one pedestrian at one frame (PedestrianBody.truth)."""
 
-    time: float
-    index: int
-    robot: RobotState
+    name: str  # the pedestrian's entity name ("ped" for a scenario's one pedestrian)
     # The pedestrian on its path (the footprint's centre), world frame.
     position_world: np.ndarray  # (2,)
     velocity_world: np.ndarray  # (2,)
@@ -150,11 +150,8 @@ class GroundTruth:
         return self.body.box_height
 
     def to_dict(self) -> dict[str, object]:
-        """Plain JSON-ready values (NaN as None), e.g. for gym infos and result lines."""
+        """Plain JSON-ready values (NaN as None)."""
         return {
-            "time": self.time,
-            "index": self.index,
-            "robot": self.robot.to_dict(),
             "position_world": _plain(self.position_world),
             "velocity_world": _plain(self.velocity_world),
             "heading_world": self.heading_world,
@@ -189,6 +186,34 @@ class GroundTruth:
             "phi": self.phi,
             "head_yaw_shoulders": self.head_yaw_shoulders,
             "head_yaw_camera": self.head_yaw_camera,
+        }
+
+
+@dataclass(frozen=True)
+class GroundTruth:
+    """Everything true at one frame: the robot's, each pedestrian's and every other body's
+    truth, each told by its own entity (sim.world.entities)."""
+
+    time: float
+    index: int
+    robot: RobotState
+    people: tuple[PersonTruth, ...]  # the scenario's pedestrian first
+    # The other bodies' truth by entity name (a parked car, a test's toy); None: nothing.
+    bodies: Mapping[str, object] = field(default_factory=dict)
+
+    @property
+    def pedestrian(self) -> PersonTruth:
+        """The scenario's pedestrian (the one its warnings are judged against)."""
+        return self.people[0]
+
+    def to_dict(self) -> dict[str, object]:
+        """Plain JSON-ready values (NaN as None), e.g. for gym infos and result lines:
+        the robot and the scenario's pedestrian."""
+        return {
+            "time": self.time,
+            "index": self.index,
+            "robot": self.robot.to_dict(),
+            **self.pedestrian.to_dict(),
         }
 
 
@@ -351,9 +376,9 @@ def case_label(velocity_world: np.ndarray, robot_yaw: float) -> tuple[Case, np.n
 
 def footprints(truth: GroundTruth, pedestrian_size: float) -> tuple[np.ndarray, np.ndarray]:
     """The robot's and the pedestrian's footprints (world frame) at one frame."""
-    r = truth.robot
+    r, p = truth.robot, truth.pedestrian
     robot = rectangle(r.position, r.yaw, r.length, r.width)
-    ped = rectangle(truth.position_world, truth.heading_world, pedestrian_size, pedestrian_size)
+    ped = rectangle(p.position_world, p.heading_world, pedestrian_size, pedestrian_size)
     return robot, ped
 
 
@@ -365,7 +390,7 @@ def footprint_gap(truth: GroundTruth, pedestrian_size: float) -> float:
 def pedestrian_passed(truth: GroundTruth, robot_length: float, footprint: float) -> bool:
     """The pedestrian is behind the robot, clear of it: nothing more can happen in this run."""
     clearance = robot_length / 2 + footprint
-    return bool(truth.position_robot[0] < -clearance)
+    return bool(truth.pedestrian.position_robot[0] < -clearance)
 
 
 NOSE, LEFT_EAR, RIGHT_EAR, LEFT_SHOULDER, RIGHT_SHOULDER = 0, 7, 8, 11, 12

@@ -149,7 +149,7 @@ class SceneRenderer(Closing):
         self._rect = mujoco.MjrRect(0, 0, self.width, self.height)
         self._camera = mujoco.MjvCamera()
         self._camera.type = mujoco.mjtCamera.mjCAMERA_FIXED
-        self._camera.fixedcamid = scene.camera_id
+        self._camera.fixedcamid = scene.robot.camera_id
         self._perturb = mujoco.MjvPerturb()
         self._option = mujoco.MjvOption()
         self._option.geomgroup[:] = [1, 1, 1, 0, 0, 0]  # hide the robot's own body
@@ -194,19 +194,20 @@ class SceneRenderer(Closing):
         """The current robot-camera image, RGB uint8 (height, width, 3)."""
         return self._draw(markers, segmentation=False).copy()
 
-    def pedestrian_mask(self) -> np.ndarray:
-        """Boolean (height, width) mask of the pixels where the pedestrian is visible.
+    def mask(self, geoms: np.ndarray) -> np.ndarray:
+        """Boolean (height, width) mask of the pixels where any of `geoms` is visible
+        (a body's geoms: Scene.geoms_of).
 
         Uses MuJoCo's segmentation rendering (each drawn geom in its own colour), so
-        occluders hide the pedestrian as they do in the colour image.
+        occluders hide the body as they do in the colour image.
         """
         image = self._draw((), segmentation=True).astype(np.int64)
         segid = image[..., 0] + (image[..., 1] << 8) + (image[..., 2] << 16)  # 0: none
         lookup = np.zeros(self._scene.ngeom + 1, dtype=bool)
-        pedestrian = set(self.scene.mannequin.geom_ids.tolist())
+        wanted = set(np.asarray(geoms).tolist())
         for k in range(self._scene.ngeom):
             g = self._scene.geoms[k]
-            if g.segid >= 0 and g.objtype == mujoco.mjtObj.mjOBJ_GEOM and g.objid in pedestrian:
+            if g.segid >= 0 and g.objtype == mujoco.mjtObj.mjOBJ_GEOM and g.objid in wanted:
                 lookup[g.segid + 1] = True
         return lookup[np.clip(segid, 0, self._scene.ngeom)]
 

@@ -27,12 +27,11 @@ ROAD_NODES = ("west", "east")
 EGO_COLOUR = (50, 200, 0)  # highway-env's ego green in its top-down view
 
 
-def highway_road(layout: RoadLayout, occluders: tuple[Occluder, ...] = ()) -> Road:
+def highway_road(layout: RoadLayout) -> Road:
     """The street of a RoadLayout as a highway-env road along the world x axis.
 
     Lanes are numbered as highway-env does, 0 the leftmost when driving east (the northern
-    one in the world); static occluders become non-collidable highway-env obstacles so
-    the top-down view shows them.
+    one in the world). Parked cars add themselves (sim.world.entities.parked_car).
     """
     net = RoadNetwork()
     _, y_left = layout.edges
@@ -52,10 +51,7 @@ def highway_road(layout: RoadLayout, occluders: tuple[Occluder, ...] = ()) -> Ro
             speed_limit=30.0,
         )
         net.add_lane(*ROAD_NODES, lane)
-    road = Road(network=net, np_random=np.random.RandomState(0), record_history=False)
-    for occ in occluders:
-        road.objects.append(occluder_obstacle(road, occ))
-    return road
+    return Road(network=net, np_random=np.random.RandomState(0), record_history=False)
 
 
 def occluder_obstacle(road: Road, occ: Occluder) -> Obstacle:

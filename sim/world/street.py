@@ -1,4 +1,4 @@
-"""The static street: road with markings, pavements, grass, buildings, parked cars.
+"""The static street: road with markings, pavements, grass, buildings.
 
 The road runs along world x (east), centred on y = `center_y`. Every walkable surface
 has its top at z = 0 so that the ground plane of monopic's camera model is exact; paint
@@ -15,7 +15,7 @@ import mujoco
 import numpy as np
 
 from sim.geometry.frames import yaw_quat
-from sim.scenario.spec import RGB, Occluder, RoadLayout
+from sim.scenario.spec import RGB, RoadLayout
 
 KERB_WIDTH = 0.15  # m
 PAINT_HEIGHT = 0.004  # m, top of the road markings above the asphalt
@@ -36,7 +36,7 @@ def _texture(spec: mujoco.MjSpec, name: str, **kw: object) -> None:
     spec.add_texture(name=name, type=mujoco.mjtTexture.mjTEXTURE_2D, width=512, height=512, **kw)
 
 
-def _material(
+def add_material(
     spec: mujoco.MjSpec,
     name: str,
     rgba: tuple[float, float, float, float],
@@ -59,7 +59,7 @@ def _material(
     return name
 
 
-def _box(
+def add_box(
     spec: mujoco.MjSpec,
     name: str,
     centre: tuple[float, float, float],
@@ -89,7 +89,7 @@ def _surface(
     material: str,
 ) -> None:
     """A box lying flat on the ground (slab, paint, grass): drawn, but casts no shadow."""
-    _box(spec, name, centre, half, material, group=SURFACE_GROUP)
+    add_box(spec, name, centre, half, material, group=SURFACE_GROUP)
 
 
 def _grid_centre(inner: float, outer: float, origin: float, period: float) -> float:
@@ -100,8 +100,9 @@ def _grid_centre(inner: float, outer: float, origin: float, period: float) -> fl
     return origin + math.copysign(periods * period, outer - inner)
 
 
-def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occluder, ...]) -> None:
-    """Add ground, road, markings, pavements, buildings and occluders to `spec`."""
+def build_street(spec: mujoco.MjSpec, road: RoadLayout) -> None:
+    """Add ground, road, markings, pavements and buildings to `spec` (parked cars are
+    entities of their own: sim.world.entities.parked_car)."""
     _texture(
         spec,
         "asphalt",
@@ -129,11 +130,11 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occlude
         rgb1=[0.27, 0.42, 0.2],
         markrgb=[0.35, 0.5, 0.25],
     )
-    asphalt = _material(spec, "asphalt", (1, 1, 1, 1), "asphalt", (0.5, 0.5))
-    slabs = _material(spec, "slabs", (1, 1, 1, 1), "slabs", (0.5, 0.5))
-    grass = _material(spec, "grass", (1, 1, 1, 1), "grass", (GRASS_REPEAT, GRASS_REPEAT))
-    paint = _material(spec, "paint", (0.92, 0.92, 0.9, 1), specular=0.1)
-    kerb = _material(spec, "kerb", (0.72, 0.71, 0.68, 1))
+    asphalt = add_material(spec, "asphalt", (1, 1, 1, 1), "asphalt", (0.5, 0.5))
+    slabs = add_material(spec, "slabs", (1, 1, 1, 1), "slabs", (0.5, 0.5))
+    grass = add_material(spec, "grass", (1, 1, 1, 1), "grass", (GRASS_REPEAT, GRASS_REPEAT))
+    paint = add_material(spec, "paint", (0.92, 0.92, 0.9, 1), specular=0.1)
+    kerb = add_material(spec, "kerb", (0.72, 0.71, 0.68, 1))
 
     _add_grass(spec, road, grass)
     half_len = road.length / 2
@@ -203,8 +204,6 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout, occluders: tuple[Occlude
 
     if road.buildings:
         _add_buildings(spec, road)
-    for k, occ in enumerate(occluders):
-        _add_occluder(spec, k, occ)
 
 
 def _add_grass(spec: mujoco.MjSpec, road: RoadLayout, grass: str) -> None:
@@ -266,7 +265,7 @@ def _add_buildings(spec: mujoco.MjSpec, road: RoadLayout) -> None:
     mats = []
     for i, c in enumerate(colours):
         _facade_texture(spec, f"facade_{i}", c)
-        mats.append(_material(spec, f"facade_{i}", (1, 1, 1, 1), f"facade_{i}", (0.4, 1 / 3)))
+        mats.append(add_material(spec, f"facade_{i}", (1, 1, 1, 1), f"facade_{i}", (0.4, 1 / 3)))
     y_right, y_left = road.edges
     setback = KERB_WIDTH + road.pavement_width + 1.0
     half_len = road.length / 2
@@ -277,7 +276,7 @@ def _add_buildings(spec: mujoco.MjSpec, road: RoadLayout) -> None:
             width = 10.0 + 5.0 * ((k * 7 + (3 if sign > 0 else 0)) % 4)
             height = 6.0 + 3.0 * ((k * 5 + (1 if sign > 0 else 2)) % 5)
             depth = 8.0
-            _box(
+            add_box(
                 spec,
                 f"building_{side}_{k}",
                 (x + width / 2, edge + sign * (setback + depth / 2), height / 2),
@@ -286,59 +285,3 @@ def _add_buildings(spec: mujoco.MjSpec, road: RoadLayout) -> None:
             )
             x += width
             k += 1
-
-
-def _add_occluder(spec: mujoco.MjSpec, k: int, occ: Occluder) -> None:
-    """A car-like occluder: a body box and a narrower cabin box on top."""
-    body_mat = _material(spec, f"occluder_{k}", (*occ.colour, 1.0), specular=0.4, shininess=0.5)
-    glass = _material(
-        spec, f"occluder_{k}_glass", (0.15, 0.18, 0.22, 1.0), specular=0.6, shininess=0.8
-    )
-    lower = 0.55 * occ.height
-    clearance = 0.18
-    _box(
-        spec,
-        f"occluder_{k}_body",
-        (occ.x, occ.y, clearance + (lower - clearance) / 2),
-        (occ.length / 2, occ.width / 2, (lower - clearance) / 2),
-        body_mat,
-        occ.yaw,
-    )
-    cab_len = 0.55 * occ.length
-    back = -0.08 * occ.length
-    cx = occ.x + math.cos(occ.yaw) * back
-    cy = occ.y + math.sin(occ.yaw) * back
-    _box(
-        spec,
-        f"occluder_{k}_cabin",
-        (cx, cy, lower + (occ.height - lower) / 2),
-        (cab_len / 2, occ.width / 2 - 0.08, (occ.height - lower) / 2),
-        glass,
-        occ.yaw,
-    )
-    # Wheels hint at a car from low camera heights and fill the gap under the body.
-    for j, (fx, fy) in enumerate(((0.33, 0.47), (0.33, -0.47), (-0.33, 0.47), (-0.33, -0.47))):
-        dx, dy = fx * occ.length, fy * occ.width
-        wx = occ.x + math.cos(occ.yaw) * dx - math.sin(occ.yaw) * dy
-        wy = occ.y + math.sin(occ.yaw) * dx + math.cos(occ.yaw) * dy
-        spec.worldbody.add_geom(
-            name=f"occluder_{k}_wheel_{j}",
-            type=mujoco.mjtGeom.mjGEOM_CYLINDER,
-            pos=[wx, wy, 0.32],
-            size=[0.32, 0.11, 0],
-            quat=_wheel_quat(occ.yaw).tolist(),
-            rgba=[0.08, 0.08, 0.08, 1],
-            contype=0,
-            conaffinity=0,
-            group=0,
-        )
-
-
-def _wheel_quat(yaw: float) -> np.ndarray:
-    """Orientation of a wheel cylinder: axis along the car's lateral direction."""
-    # Cylinder axis is local z; turn it to the car's y axis: yaw, then 90 deg about x.
-    qz = yaw_quat(yaw)
-    qx = np.array([math.cos(math.pi / 4), math.sin(math.pi / 4), 0.0, 0.0])
-    out = np.zeros(4)
-    mujoco.mju_mulQuat(out, qz, qx)
-    return out

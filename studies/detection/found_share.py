@@ -104,7 +104,7 @@ class FoundCounter(Listener):
         assert frame.step.frame is not None
         image, truth = frame.step.frame.image, frame.truth
         result = self.tracker.process(image)
-        u0, v0, u1, v1 = truth.box
+        u0, v0, u1, v1 = truth.pedestrian.box
         if not (u0 >= 0 and v0 >= 0 and u1 <= self.width and v1 <= self.height):
             self.skipped += 1
             return
@@ -114,13 +114,13 @@ class FoundCounter(Listener):
             cx, cy = (bx0 + bx1) / 2, (by0 + by1) / 2
             found = u0 <= cx <= u1 and v0 <= cy <= v1
             false = not found
-        b = bucket_of(truth.apparent_height / self.height)
+        b = bucket_of(truth.pedestrian.apparent_height / self.height)
         for tally in (self.by_bucket[b], self.by_case[b]):
             tally.frames += 1
             tally.found += found
             tally.false += false
         if frame.index == self.thumb_at:
-            self.thumbs.append(annotate(image, self.thumb_label, truth.box, result))
+            self.thumbs.append(annotate(image, self.thumb_label, truth.pedestrian.box, result))
 
 
 def bucket_of(ratio: float) -> int:

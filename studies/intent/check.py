@@ -47,13 +47,13 @@ def labels(families: list[str]) -> None:
             changes, previous = [], None
             with World(sc, render=False) as world:
                 for step in world.run():
-                    truth = step.truth
-                    if truth.intent != previous:
+                    person = step.truth.pedestrian
+                    if person.intent != previous:
                         changes.append(
-                            f"{step.time:.2f} s {truth.intent.value} "
-                            f"(case now {int(truth.case_now)}, {truth.speed:.2f} m/s)"
+                            f"{step.time:.2f} s {person.intent.value} "
+                            f"(case now {int(person.case_now)}, {person.speed:.2f} m/s)"
                         )
-                        previous = truth.intent
+                        previous = person.intent
             print(f"{name} [{model}]: " + " -> ".join(changes))
 
 
@@ -73,9 +73,9 @@ def features(case: Case, robot_speed: float) -> None:
             rows.append(
                 (
                     step.time,
-                    math.degrees(step.truth.head_yaw_shoulders),
+                    math.degrees(step.truth.pedestrian.head_yaw_shoulders),
                     f.head_yaw if f is not None else nan,
-                    step.truth.speed,
+                    step.truth.pedestrian.speed,
                     g.speed if g is not None else nan,
                     math.hypot(*g.velocity) if g is not None else nan,
                     g.acceleration if g is not None else nan,

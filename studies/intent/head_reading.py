@@ -111,9 +111,11 @@ def render_still(scene: Scene, renderer: SceneRenderer, tracker: PoseTracker, ba
                  distance: float, body: float, head: float) -> Still:  # fmt: skip
     """Render one still and track it."""
     sight = math.atan2(LATERAL_M, distance)
-    scene.set_pedestrian(
-        distance, LATERAL_M, sight + math.pi - math.radians(body), head_yaw=math.radians(head)
-    )
+    scene.pedestrians[0].pose_at(
+        scene.model, scene.data, distance, LATERAL_M, sight + math.pi - math.radians(body),
+        head_yaw=math.radians(head),
+    )  # fmt: skip
+    scene.update()
     image = renderer.render()
     tracker.reset()
     result = tracker.process(image, band=band)

@@ -174,11 +174,14 @@ def test_the_worlds_truth_carries_the_labels() -> None:
         if abs(truth.time - 2.0) < 1e-9:
             continue  # the stop itself: "now" or an instant before it
         if 1.0 - 1e-9 <= truth.time < 2.0:
-            assert truth.intent is Intent.STOP
-            assert truth.intent_time == pytest.approx(2.0 - truth.time)
-            assert truth.case_now is Case.PERPENDICULAR_RIGHT
+            assert truth.pedestrian.intent is Intent.STOP
+            assert truth.pedestrian.intent_time == pytest.approx(2.0 - truth.time)
+            assert truth.pedestrian.case_now is Case.PERPENDICULAR_RIGHT
         else:
-            assert truth.intent is Intent.KEEP_GOING and truth.intent_time is None
+            assert (
+                truth.pedestrian.intent is Intent.KEEP_GOING
+                and truth.pedestrian.intent_time is None
+            )
     row = truths[20].to_dict()
     assert (row["intent"], row["case_now"]) == ("stop", int(Case.PERPENDICULAR_RIGHT))
 

@@ -54,7 +54,7 @@ def test_contact_ends_the_loop_after_its_frame_unless_told_to_go_on():
     scenario = crossing()
     with World(scenario, render=False) as world:
         end = run_loop(world, (), [], frames=scenario.frames)
-        assert end.reason == "contact" and end.final.truth.contact
+        assert end.reason == "contact" and end.final.truth.pedestrian.contact
         assert end.contact_time == pytest.approx(end.final.time)
         assert end.frames == end.final.index + 1 < scenario.frames
         on = run_loop(world, (), [], frames=scenario.frames, stop_at_contact=False)

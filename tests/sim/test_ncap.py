@@ -134,9 +134,11 @@ def test_the_camera_dips_when_braking_but_the_pipeline_keeps_its_camera():
         assert step.ego.camera == world.camera  # the pipeline's: nominal
         true = world.true_camera
         assert true.pitch == pytest.approx(world.camera.pitch + world.pitch)
-        px = step.truth.body.landmarks_px
-        assert np.allclose(px, true.project(step.truth.body.landmarks_robot), equal_nan=True)
-        assert not np.allclose(px, world.camera.project(step.truth.body.landmarks_robot))
+        px = step.truth.pedestrian.body.landmarks_px
+        assert np.allclose(
+            px, true.project(step.truth.pedestrian.body.landmarks_robot), equal_nan=True
+        )
+        assert not np.allclose(px, world.camera.project(step.truth.pedestrian.body.landmarks_robot))
         for _ in range(60):  # standing: the body settles back
             world.step(action=0.0)
         assert abs(world.pitch) < math.radians(0.05)

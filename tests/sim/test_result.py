@@ -57,6 +57,9 @@ def every_field_set() -> RunResult:
             pedestrian_height=1.15,
             pedestrian_speed=1.4,
             occluders=2,
+            behaviour="human",
+            cues=True,
+            lighting="overcast",
         ),  # fmt: skip
         schema=SCHEMA,
         sweep="demo",
@@ -125,6 +128,19 @@ def test_lines_before_the_walker_model_was_summarised_take_the_sweeps_setting() 
     named["scenario"]["behaviour"] = "rail"
     named["params"] = {"pedestrian.behaviour.model": "human"}  # the summary wins when present
     assert RunResult.from_json(named).scenario.behaviour == "rail"
+
+
+def test_lines_before_the_lighting_was_recorded_read_as_the_preset_they_used() -> None:
+    line = every_field_set().to_json()
+    del line["scenario"]["lighting"]
+    assert RunResult.from_json(line).scenario.lighting == "overcast"  # the sweep set it
+    line["params"] = {}
+    assert RunResult.from_json(line).scenario.lighting == "noon"  # a file's default
+    line["file"] = ""
+    assert RunResult.from_json(line).scenario.lighting == "day"  # built in code
+    named = every_field_set().to_json()
+    named["params"] = {"scene.lighting": "morning"}  # the summary wins when present
+    assert RunResult.from_json(named).scenario.lighting == "overcast"
 
 
 def test_lines_of_older_code_read_in_the_registry_vocabulary() -> None:

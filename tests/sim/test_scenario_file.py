@@ -189,7 +189,7 @@ def test_ncap_placement_meets_the_robot_at_the_impact_time(
     impact = params.get("path.impact_time", f.data["path"]["impact_time"])
     with World(scenario, render=False) as world:
         truth = world.reset().truth
-        assert truth.time_to_collision == pytest.approx(impact, abs=1e-6)
+        assert truth.pedestrian.time_to_collision == pytest.approx(impact, abs=1e-6)
         # Where the pedestrian is at contact, across the robot's width.
         side = params.get("path.side", f.data["path"].get("side", "near"))
         share = params.get("path.impact_point", f.data["path"]["impact_point"])
@@ -214,7 +214,10 @@ def test_near_misses_and_a_standing_robot_never_meet_the_pedestrian(file: str) -
     scenario = f.scenario({"robot.speed": speed}, "t", 0)
     with World(scenario, render=False) as world:
         truth = world.reset().truth
-        assert truth.time_to_collision is None or truth.time_to_collision > scenario.duration
+        assert (
+            truth.pedestrian.time_to_collision is None
+            or truth.pedestrian.time_to_collision > scenario.duration
+        )
     if "cpna" in file:
         assert scenario.case is Case.PERPENDICULAR_LEFT
     assert math.isfinite(scenario.horizon)
@@ -223,7 +226,8 @@ def test_near_misses_and_a_standing_robot_never_meet_the_pedestrian(file: str) -
 def test_overcast_lighting_turns_the_shadow_pass_off(tmp_path: Path) -> None:
     sunny = load(write(tmp_path, BASE, "sunny.toml")).base
     overcast = load(write(tmp_path, BASE + '[scene]\nlighting = "overcast"\n', "o.toml")).base
-    assert sunny.scene.shadows and not overcast.scene.shadows
+    assert sunny.scene.lighting.shadows and not overcast.scene.lighting.shadows
+    assert (sunny.scene.lighting.name, overcast.scene.lighting.name) == ("noon", "overcast")
     with World(overcast, render=False) as world:
         assert not world.scene.model.light_castshadow.any()
     with World(sunny, render=False) as world:

@@ -16,6 +16,7 @@ from monopic.camera import CameraModel
 from sim.dataset.clip import ClipSpec, clip_scene, truth_header, truth_row, walk
 from sim.geometry.frames import Pose2D
 from sim.scenario.spec import MannequinSpec, Occluder, RoadLayout, SceneSpec
+from sim.world.body import PedestrianTruth
 from sim.world.gait import JOINT_FIELDS, Gait, idle_pose, pose_vector
 from sim.world.mannequin import geom_z_extent
 from sim.world.render import GLUnavailableError, Marker, SceneRenderer
@@ -28,6 +29,17 @@ SMALL = CameraModel.from_fov(320, 180, vertical_fov_deg=65.0, mount_height=1.2, 
 ROBOT = Pose2D(3.0, -2.0, 0.7)
 
 
+def stand(scene: Scene, *args: object, **kw: object) -> None:
+    """Stand the still scene's person (PedestrianBody.pose_at) and update the scene."""
+    scene.pedestrians[0].pose_at(scene.model, scene.data, *args, **kw)  # type: ignore[arg-type]
+    scene.update()
+
+
+def seen(scene: Scene) -> PedestrianTruth:
+    """The still scene's person as the camera sees them."""
+    return scene.pedestrians[0].seen(scene.data, scene.camera, scene.robot_pose)
+
+
 def small_scene(camera: CameraModel = SMALL, **kw: object) -> Scene:
     """A light scene (no buildings) with the pedestrian placed behind the camera."""
     spec = SceneSpec(road=RoadLayout(buildings=False), **kw)  # type: ignore[arg-type]
@@ -35,7 +47,7 @@ def small_scene(camera: CameraModel = SMALL, **kw: object) -> Scene:
     scene = Scene(config)
     scene.set_camera_pose(ROBOT.x, ROBOT.y, ROBOT.yaw)
     behind = ROBOT.to_world(np.array([-10.0, 0.0, 0.0]))
-    scene.set_pedestrian(behind[0], behind[1], 0.0)
+    stand(scene, behind[0], behind[1], 0.0)
     return scene
 
 
@@ -87,12 +99,12 @@ def test_right_in_the_world_is_right_in_the_image() -> None:
 def test_person_facing_the_camera_shows_their_left_on_the_image_right() -> None:
     scene = small_scene()
     ahead = ROBOT.to_world(np.array([4.0, 0.0, 0.0]))
-    scene.set_pedestrian(ahead[0], ahead[1], ROBOT.yaw + math.pi)  # facing the robot
-    px = scene.truth().landmarks_px
+    stand(scene, ahead[0], ahead[1], ROBOT.yaw + math.pi)  # facing the robot
+    px = seen(scene).landmarks_px
     assert px[11, 0] > px[12, 0]  # left shoulder right of the right shoulder
     assert px[23, 0] > px[24, 0] and px[2, 0] > px[5, 0]
-    scene.set_pedestrian(ahead[0], ahead[1], ROBOT.yaw)  # back to the robot
-    px = scene.truth().landmarks_px
+    stand(scene, ahead[0], ahead[1], ROBOT.yaw)  # back to the robot
+    px = seen(scene).landmarks_px
     assert px[11, 0] < px[12, 0]
 
 
@@ -101,17 +113,17 @@ def test_person_facing_the_camera_shows_their_left_on_the_image_right() -> None:
 )
 def test_mannequin_height_and_feet_on_the_ground(look: MannequinSpec, height: float) -> None:
     scene = Scene(SceneConfig(pedestrian=look, spec=SceneSpec(road=RoadLayout(buildings=False))))
-    scene.set_pedestrian(1.0, 2.0, 0.3)  # idle stance
-    truth = scene.truth()
+    stand(scene, 1.0, 2.0, 0.3)  # idle stance
+    truth = seen(scene)
     assert truth.top_z == pytest.approx(height, abs=0.01)
-    shoes = scene.mannequin.shoe_geoms
+    shoes = scene.pedestrians[0].mannequin.shoe_geoms
     assert np.min(geom_z_extent(scene.model, scene.data, shoes)[0]) == pytest.approx(0.0, abs=1e-9)
     # Shoulders, hips and knees at human heights (fractions of stature).
     z = truth.landmarks_world[:, 2] / height
     assert 0.76 < z[11] < 0.84 and 0.48 < z[23] < 0.56 and 0.25 < z[25] < 0.31
     # While walking one foot always touches the ground.
     for phase in np.linspace(0, 1, 9):
-        scene.set_pedestrian(1.0, 2.0, 0.3, gait_phase=phase, speed=1.2)
+        stand(scene, 1.0, 2.0, 0.3, gait_phase=phase, speed=1.2)
         low = np.min(geom_z_extent(scene.model, scene.data, shoes)[0])
         assert low == pytest.approx(0.0, abs=1e-9)
 
@@ -141,7 +153,7 @@ def test_cadence_follows_speed_and_size() -> None:
 
 def knee_angles(scene: Scene) -> np.ndarray:
     """Knee flexion (rad) of both legs from the hip, knee and ankle landmarks."""
-    lm = scene.truth().landmarks_world
+    lm = seen(scene).landmarks_world
     out = []
     for hip, knee, ankle in ((23, 25, 27), (24, 26, 28)):
         thigh, shin = lm[knee] - lm[hip], lm[ankle] - lm[knee]
@@ -154,21 +166,21 @@ def test_knees_bend_when_walking_and_not_when_standing() -> None:
     scene = Scene(SceneConfig(spec=SceneSpec(road=RoadLayout(buildings=False))))
     flex = []
     for phase in np.linspace(0, 1, 20, endpoint=False):
-        scene.set_pedestrian(0.0, 0.0, 0.0, gait_phase=phase, speed=1.4)
+        stand(scene, 0.0, 0.0, 0.0, gait_phase=phase, speed=1.4)
         flex.append(knee_angles(scene))
     flex_deg = np.degrees(np.array(flex))
     assert flex_deg.max() > 50 and flex_deg.min() < 10
     # The stance leg is straight while the swing knee bends: they alternate.
     assert np.corrcoef(flex_deg[:, 0], flex_deg[:, 1])[0, 1] < 0
-    scene.set_pedestrian(0.0, 0.0, 0.0, speed=0.0)
+    stand(scene, 0.0, 0.0, 0.0, speed=0.0)
     assert np.degrees(knee_angles(scene)).max() < 6
 
 
 def test_foot_point_box_and_landmarks_agree() -> None:
     scene = small_scene()
     spot = ROBOT.to_world(np.array([4.0, 0.5, 0.0]))
-    scene.set_pedestrian(spot[0], spot[1], ROBOT.yaw + 2.0, gait_phase=0.3, speed=1.4)
-    truth = scene.truth()
+    stand(scene, spot[0], spot[1], ROBOT.yaw + 2.0, gait_phase=0.3, speed=1.4)
+    truth = seen(scene)
     u0, v0, u1, v1 = truth.box
     inside = truth.landmarks_px
     assert np.all((inside[:, 0] >= u0) & (inside[:, 0] <= u1))
@@ -186,9 +198,9 @@ def test_mask_sees_the_pedestrian_and_an_occluder_hides_it() -> None:
     for occluders in ((), (Occluder.parked_car(car[0], car[1], ROBOT.yaw + math.pi / 2),)):
         scene = small_scene(occluders=occluders)
         world = ROBOT.to_world(spot)
-        scene.set_pedestrian(world[0], world[1], ROBOT.yaw + math.pi)
+        stand(scene, world[0], world[1], ROBOT.yaw + math.pi)
         with SceneRenderer(scene) as renderer:
-            visible.append(int(renderer.pedestrian_mask().sum()))
+            visible.append(int(renderer.mask(scene.geoms_of(scene.pedestrians[0])).sum()))
     assert visible[0] > 300
     assert visible[1] < 0.6 * visible[0]
 
@@ -196,7 +208,7 @@ def test_mask_sees_the_pedestrian_and_an_occluder_hides_it() -> None:
 def test_renders_are_deterministic() -> None:
     scene = small_scene()
     spot = ROBOT.to_world(np.array([4.0, 0.0, 0.0]))
-    scene.set_pedestrian(spot[0], spot[1], 1.0, gait_phase=0.4, speed=1.4)
+    stand(scene, spot[0], spot[1], 1.0, gait_phase=0.4, speed=1.4)
     with SceneRenderer(scene) as renderer:
         a = renderer.render()
         b = renderer.render()
@@ -218,7 +230,7 @@ def test_shipped_clip_truth_matches_the_scene() -> None:
     """tests/data/walk_clip_truth.csv is what sim.dataset.clip computes (no rendering needed)."""
     clip = ClipSpec()
     scene = clip_scene(clip)
-    expected = [truth_row(k, t, scene.truth()) for k, t in walk(clip, scene)]
+    expected = [truth_row(k, t, seen(scene)) for k, t in walk(clip, scene)]
     with (DATA / "walk_clip_truth.csv").open() as fh:
         rows = list(csv.reader(fh))
     assert rows[0] == truth_header()
@@ -231,7 +243,7 @@ def test_shipped_clip_truth_matches_the_scene() -> None:
 def _street_geoms(road: RoadLayout) -> dict[str, tuple[np.ndarray, np.ndarray]]:
     """name -> (centre, half size) of every box build_street adds, no GL needed."""
     spec = mujoco.MjSpec()
-    build_street(spec, road, ())
+    build_street(spec, road)
     model = spec.compile()
     return {
         model.geom(g).name: (model.geom_pos[g].copy(), model.geom_size[g].copy())
@@ -286,8 +298,8 @@ def test_the_pedestrian_still_casts_its_shadow_on_the_road() -> None:
     with SceneRenderer(scene) as renderer:
         empty = renderer.render().astype(int)
         spot = ROBOT.to_world(np.array([3.0, 0.0, 0.0]))
-        scene.set_pedestrian(spot[0], spot[1], ROBOT.yaw + math.pi / 2)
+        stand(scene, spot[0], spot[1], ROBOT.yaw + math.pi / 2)
         image = renderer.render().astype(int)
-        body = renderer.pedestrian_mask()
+        body = renderer.mask(scene.geoms_of(scene.pedestrians[0]))
     darker = (image.sum(-1) < empty.sum(-1) - 30) & ~body
     assert darker.sum() > 40  # 62 pixels of shadow beside the 740 of the body

@@ -135,9 +135,9 @@ def test_recording_holds_camera_truth_world_and_series(tmp_path):
             if len(truth) == n:
                 break
     phi = values(rrd, "/truth/phi")
-    assert phi == pytest.approx([t.phi for t in truth])
+    assert phi == pytest.approx([t.pedestrian.phi for t in truth])
     ttc = values(rrd, "/ttc/truth")
-    assert ttc == pytest.approx([t.time_to_collision for t in truth])
+    assert ttc == pytest.approx([t.pedestrian.time_to_collision for t in truth])
     assert ttc[0] == pytest.approx(truth[0].time_to_collision) and 0.5 < ttc[0] < 1.0
     gap = values(rrd, "/truth/gap")
     assert gap[-1] == 0.0 and gap[0] == pytest.approx(

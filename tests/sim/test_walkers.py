@@ -144,9 +144,12 @@ def test_the_time_to_contact_of_a_human_walker_agrees_with_a_brute_force_search(
         truth = world.reset().truth
         brute = first_overlap_brute_force(world, scenario.duration)
         if brute is None:
-            assert truth.time_to_collision is None or truth.time_to_collision > scenario.duration
+            assert (
+                truth.pedestrian.time_to_collision is None
+                or truth.pedestrian.time_to_collision > scenario.duration
+            )
         else:
-            assert truth.time_to_collision == pytest.approx(brute, abs=0.0015)
+            assert truth.pedestrian.time_to_collision == pytest.approx(brute, abs=0.0015)
 
 
 @pytest.mark.parametrize(
@@ -246,7 +249,7 @@ def test_the_truth_reads_the_head_yaw_off_the_posed_body():
 
     scenario = Scenario(name="look", pedestrian=spec, duration=4.0)
     with World(scenario, render=False) as world:
-        seen = [(s.truth.head_yaw_shoulders, world.pedestrian.state.head_yaw)  # type: ignore[union-attr]
+        seen = [(s.truth.pedestrian.head_yaw_shoulders, world.pedestrian.state.head_yaw)  # type: ignore[union-attr]
                 for s in world.run()]  # fmt: skip
     measured, commanded = np.array(seen).T
     assert np.abs(commanded).max() > math.radians(30)

@@ -117,11 +117,11 @@ def test_right_in_highway_env_is_right_in_the_image(side: str, sign: float) -> N
     assert cols.size > 200
     centre = SMALL_CAMERA.width / 2
     if sign > 0:
-        assert cols.min() > centre and step.truth.centre_px[0] > centre
-        assert step.truth.position_robot[1] < 0  # robot frame: y is left
+        assert cols.min() > centre and step.truth.pedestrian.centre_px[0] > centre
+        assert step.truth.pedestrian.position_robot[1] < 0  # robot frame: y is left
     else:
-        assert cols.max() < centre and step.truth.centre_px[0] < centre
-        assert step.truth.position_robot[1] > 0
+        assert cols.max() < centre and step.truth.pedestrian.centre_px[0] < centre
+        assert step.truth.pedestrian.position_robot[1] > 0
 
 
 def test_marker_lands_on_the_camera_model_projection_with_a_moving_robot() -> None:
@@ -225,14 +225,14 @@ def test_head_on_time_to_collision_is_known() -> None:
     ped = PedestrianSpec(x=10.0, y=0.0, heading_deg=180.0, speed=1.5)
     truths = run_truth(scenario(ped, robot_speed=2.0, duration=3.0))
     t_contact = 9.35 / 3.5
-    assert truths[0].time_to_collision == pytest.approx(t_contact, abs=1e-9)
+    assert truths[0].pedestrian.time_to_collision == pytest.approx(t_contact, abs=1e-9)
     for truth in truths:
         expected_ttc = max(t_contact - truth.time, 0.0)
-        assert truth.time_to_collision == pytest.approx(expected_ttc, abs=1e-9)
-        assert truth.contact == (truth.time >= t_contact)
-        assert truth.collision == (truth.time >= t_contact - 1.0)
-    assert [t.index for t in truths if t.contact][0] == 41
-    assert [t.index for t in truths if t.collision][0] == 26
+        assert truth.pedestrian.time_to_collision == pytest.approx(expected_ttc, abs=1e-9)
+        assert truth.pedestrian.contact == (truth.time >= t_contact)
+        assert truth.pedestrian.collision == (truth.time >= t_contact - 1.0)
+    assert [t.index for t in truths if t.pedestrian.contact][0] == 41
+    assert [t.index for t in truths if t.pedestrian.collision][0] == 26
 
 
 def test_highway_env_flags_the_same_contact() -> None:
@@ -242,7 +242,7 @@ def test_highway_env_flags_the_same_contact() -> None:
         for _ in range(41):
             step = world.step()
             assert world.pedestrian is not None
-            assert world.pedestrian.hit == step.truth.contact
+            assert world.pedestrian.hit == step.truth.pedestrian.contact
 
 
 @pytest.mark.parametrize("offset, meets", [(0.60, False), (0.50, True)])
@@ -252,11 +252,11 @@ def test_side_by_side_near_miss_and_graze(offset: float, meets: bool) -> None:
     ped = PedestrianSpec(x=10.0, y=offset, heading_deg=180.0, speed=1.5)
     truths = run_truth(scenario(ped, duration=4.0))
     if meets:
-        assert truths[0].time_to_collision == pytest.approx(9.35 / 3.5, abs=1e-9)
-        assert any(t.contact for t in truths)
+        assert truths[0].pedestrian.time_to_collision == pytest.approx(9.35 / 3.5, abs=1e-9)
+        assert any(t.pedestrian.contact for t in truths)
     else:
-        assert all(t.time_to_collision is None for t in truths)
-        assert not any(t.contact or t.collision for t in truths)
+        assert all(t.pedestrian.time_to_collision is None for t in truths)
+        assert not any(t.pedestrian.contact or t.pedestrian.collision for t in truths)
 
 
 def test_crossing_ahead_in_time_is_a_near_miss() -> None:
@@ -266,15 +266,17 @@ def test_crossing_ahead_in_time_is_a_near_miss() -> None:
         Case.PERPENDICULAR_RIGHT, distance=6.0, robot_speed=2.0, meet_time=1.5
     ).scenario()
     truths = run_truth(replace(sc, scene=LIGHT_SCENE, duration=4.0))
-    assert all(t.time_to_collision is None and not t.collision for t in truths)
+    assert all(
+        t.pedestrian.time_to_collision is None and not t.pedestrian.collision for t in truths
+    )
 
 
 def test_default_crossing_collides_unless_the_robot_brakes() -> None:
     truths = run_truth(default_crossing())
-    assert any(t.contact for t in truths)
+    assert any(t.pedestrian.contact for t in truths)
     with World(default_crossing(), render=False) as world:
         braked = list(world.run(policy=lambda step: -8.0))
-    assert not any(s.truth.contact for s in braked)
+    assert not any(s.truth.pedestrian.contact for s in braked)
     assert braked[-1].truth.robot.speed == 0.0
 
 
@@ -288,9 +290,9 @@ def test_the_true_path_with_a_turn_decides_the_collision() -> None:
         x=-1.0, y=3.0, heading_deg=0.0, speed=1.0, legs=(Leg(at=1.0, speed=1.0, turn_deg=-90.0),)
     )
     truths = run_truth(scenario(ped, robot_speed=0.0, duration=4.0))
-    assert truths[0].time_to_collision == pytest.approx(3.45, abs=1e-9)
-    assert truths[0].case is Case.AWAY  # the next second is still the walk east
-    assert truths[30].case is Case.PERPENDICULAR_RIGHT  # t = 2 s, walking south
+    assert truths[0].pedestrian.time_to_collision == pytest.approx(3.45, abs=1e-9)
+    assert truths[0].pedestrian.case is Case.AWAY  # the next second is still the walk east
+    assert truths[30].pedestrian.case is Case.PERPENDICULAR_RIGHT  # t = 2 s, walking south
 
 
 rect = st.tuples(
@@ -342,13 +344,13 @@ def test_every_placed_case_is_labelled_as_that_case(case: Case, params: dict) ->
     sc = replace(CasePlacement(case, **params).scenario(), scene=LIGHT_SCENE)
     truths = run_truth(sc)
     assert len(truths) == sc.frames
-    assert {t.case for t in truths} == {case}
+    assert {t.pedestrian.case for t in truths} == {case}
     # In the middle of the run the pedestrian is where the placement put it.
     mid = truths[sc.frames // 2]
     robot_x = mid.robot.position[0]
     distance = params.get("distance", 8.0)
-    assert mid.position_world[0] == pytest.approx(distance, abs=0.01)
-    assert mid.position_robot[0] == pytest.approx(distance - robot_x, abs=0.01)
+    assert mid.pedestrian.position_world[0] == pytest.approx(distance, abs=0.01)
+    assert mid.pedestrian.position_robot[0] == pytest.approx(distance - robot_x, abs=0.01)
 
 
 def test_oblique_angles_outside_their_sector_are_refused() -> None:
@@ -366,11 +368,13 @@ def test_true_phi_matches_the_pipeline_formula_on_true_shoulders(facing_deg: flo
     with World(replace(sc, scene=LIGHT_SCENE), render=False) as world:
         truth = world.reset().truth
         camera = world.camera
-    lm = camera.to_camera(truth.body.landmarks_robot[[11, 12]])
+    lm = camera.to_camera(truth.pedestrian.body.landmarks_robot[[11, 12]])
     # In the pipeline, z comes in the x scale: optical-frame metres keep that isotropy.
     phi_landmarks = facing_angle(lm[0], lm[1])
-    assert truth.phi == pytest.approx(phi_landmarks, abs=6.0)
-    assert wrap_angle(truth.facing_yaw - math.radians(facing_deg)) == pytest.approx(0.0, abs=1e-9)
+    assert truth.pedestrian.phi == pytest.approx(phi_landmarks, abs=6.0)
+    assert wrap_angle(truth.pedestrian.facing_yaw - math.radians(facing_deg)) == pytest.approx(
+        0.0, abs=1e-9
+    )
 
 
 def test_a_parked_car_occludes_a_child_behind_it() -> None:
@@ -381,9 +385,9 @@ def test_a_parked_car_occludes_a_child_behind_it() -> None:
         0
     ]
     truth_clear = run_truth(replace(scenario(child, robot_speed=0.0, scene=aside), duration=0.2))[0]
-    assert truth_hidden.occluded and truth_hidden.visible_fraction < 0.2
-    assert not truth_clear.occluded and truth_clear.visible_fraction == 1.0
-    assert truth_hidden.in_frame and truth_clear.in_frame
+    assert truth_hidden.pedestrian.occluded and truth_hidden.pedestrian.visible_fraction < 0.2
+    assert not truth_clear.pedestrian.occluded and truth_clear.pedestrian.visible_fraction == 1.0
+    assert truth_hidden.pedestrian.in_frame and truth_clear.pedestrian.in_frame
 
 
 # -- determinism ------------------------------------------------------------------------------
@@ -408,8 +412,10 @@ def test_same_seed_same_frames_and_truth() -> None:
         assert sa.truth.to_dict() == sb.truth.to_dict()
     assert a[-1].frame is not None and a[-1].frame.image.std() > 10
     # Another seed starts the gait elsewhere: the body differs, the path does not.
-    assert not np.allclose(a[0].truth.body.landmarks_world, c[0].truth.body.landmarks_world)
-    assert np.allclose(a[-1].truth.position_world, c[-1].truth.position_world)
+    assert not np.allclose(
+        a[0].truth.pedestrian.body.landmarks_world, c[0].truth.pedestrian.body.landmarks_world
+    )
+    assert np.allclose(a[-1].truth.pedestrian.position_world, c[-1].truth.pedestrian.position_world)
 
 
 # -- processes -----------------------------------------------------------------------------
