@@ -20,21 +20,11 @@ import math
 import mujoco
 import numpy as np
 
-from monopic.pose.skeleton import LANDMARK_NAMES
-from sim.geometry.frames import yaw_quat
 from sim.scenario.spec import RGBA, MannequinSpec
-from sim.world.gait import JOINT_FIELDS, MannequinPose
+from sim.world.mannequin.compiled import Mannequin
+from sim.world.mannequin.landmarks import BLAZEPOSE_NAMES, N_LANDMARKS, SITE_GROUP, landmark_site
 from sim.world.mannequin.proportions import Proportions
 from sim.world.mannequin.shapes import GeomShapes, geom_z_extent
-
-# BlazePose's 33 landmarks, indexed as MediaPipe numbers them; left/right are the
-# person's own. One list for the whole project: the pipeline's.
-BLAZEPOSE_NAMES = LANDMARK_NAMES
-N_LANDMARKS = len(BLAZEPOSE_NAMES)
-
-# Geom and site groups: the robot camera shows geom groups 0-2; sites are kept in a
-# hidden group so the landmark markers never show up in a frame.
-SITE_GROUP = 4
 
 
 def _quat_from_axes(x_axis: np.ndarray, z_axis: np.ndarray) -> np.ndarray:
@@ -98,7 +88,9 @@ def build_mannequin(spec: mujoco.MjSpec, look: MannequinSpec, prefix: str) -> No
         g.mass = 1.0  # kinematic only; any positive mass keeps the compiler happy
 
     def site(body: mujoco.MjsBody, index: int, pos: list[float]) -> None:
-        body.add_site(name=f"{prefix}lm{index:02d}", pos=pos, size=[0.005, 0, 0], group=SITE_GROUP)
+        body.add_site(
+            name=landmark_site(prefix, index), pos=pos, size=[0.005, 0, 0], group=SITE_GROUP
+        )
 
     # Pelvis: the root, at hip-joint height, with a free joint.
     pelvis = spec.worldbody.add_body(name=prefix + "pelvis", pos=[0, 0, p.hip_z])
@@ -439,95 +431,6 @@ def build_mannequin(spec: mujoco.MjSpec, look: MannequinSpec, prefix: str) -> No
         site(foot, 27 + lm, [0, 0, 0])
         site(foot, 29 + lm, [-p.heel_back + 0.01 * b, 0, -p.ankle_z + 0.3 * p.ankle_z])
         site(foot, 31 + lm, [toe_end - 0.01 * b, 0, -p.ankle_z + 0.3 * p.ankle_z])
-
-
-class Mannequin:
-    """A compiled mannequin: where its state lives in the model and how to pose it."""
-
-    def __init__(self, model: mujoco.MjModel, look: MannequinSpec, prefix: str) -> None:
-        self.look = look
-        self.prefix = prefix
-        self.proportions = Proportions.of(look.height)
-        root = model.joint(prefix + "root")
-        self.root_qpos = int(root.qposadr[0])
-        self.joint_qpos = np.array(
-            [int(model.joint(prefix + name).qposadr[0]) for name in JOINT_FIELDS]
-        )
-        self.landmark_sites = np.array(
-            [model.site(f"{prefix}lm{i:02d}").id for i in range(N_LANDMARKS)]
-        )
-        root_body = model.body(prefix + "pelvis").id
-        bodies = [i for i in range(model.nbody) if _has_ancestor(model, i, root_body)]
-        self.body_ids = np.array(bodies)
-        body_set = set(bodies)
-        self.geom_ids = np.array(
-            [g for g in range(model.ngeom) if model.geom_bodyid[g] in body_set]
-        )
-        self.shoe_geoms = np.array(
-            [
-                model.geom(f"{prefix}shoe_{part}_{side}").id
-                for part in ("sole", "heel", "toe")
-                for side in ("l", "r")
-            ]
-        )
-        self.foot_sites = np.array(
-            [[model.site(f"{prefix}lm{i:02d}").id for i in pair] for pair in ((29, 31), (30, 32))]
-        )
-        self.shapes = GeomShapes.of(model, self.geom_ids)
-        self.shoe_shapes = GeomShapes.of(model, self.shoe_geoms, n=1)
-
-    def place(
-        self,
-        model: mujoco.MjModel,
-        data: mujoco.MjData,
-        x: float,
-        y: float,
-        yaw: float,
-        pose: MannequinPose,
-    ) -> None:
-        """Pose the mannequin and stand it on the ground at (x, y) facing `yaw`.
-
-        Runs forward kinematics twice: once to find the lowest point of the shoes, once
-        after lifting or lowering the root so that point touches z = 0.
-        """
-        heading = yaw + pose.pelvis_yaw
-        sway_x = -math.sin(yaw) * pose.sway
-        sway_y = math.cos(yaw) * pose.sway
-        q = data.qpos
-        q[self.root_qpos : self.root_qpos + 3] = (x + sway_x, y + sway_y, self.proportions.hip_z)
-        q[self.root_qpos + 3 : self.root_qpos + 7] = yaw_quat(heading)
-        q[self.joint_qpos] = [getattr(pose, name) for name in JOINT_FIELDS]
-        mujoco.mj_kinematics(model, data)
-        lowest = float(np.min(self.shoe_shapes.z_extent(data)[0]))
-        q[self.root_qpos + 2] -= lowest
-        mujoco.mj_kinematics(model, data)
-
-    def landmarks(self, data: mujoco.MjData) -> np.ndarray:
-        """World positions (33, 3) of the BlazePose landmarks, in BlazePose order."""
-        return data.site_xpos[self.landmark_sites].copy()
-
-    def foot_point(self, data: mujoco.MjData) -> np.ndarray:
-        """Midpoint between the two feet (each the middle of heel and toe), on the ground."""
-        feet = data.site_xpos[self.foot_sites].mean(axis=1)
-        point = feet.mean(axis=0)
-        point[2] = 0.0
-        return point
-
-    def top_height(self, data: mujoco.MjData) -> float:
-        """Highest point of the mannequin above the ground (m)."""
-        return float(np.max(self.shapes.z_extent(data)[1]))
-
-    def surface_points(self, data: mujoco.MjData) -> np.ndarray:
-        """Points (N, 3) sampled on every geom's surface, for the apparent box."""
-        return self.shapes.surface_points(data)
-
-
-def _has_ancestor(model: mujoco.MjModel, body: int, ancestor: int) -> bool:
-    while body > 0:
-        if body == ancestor:
-            return True
-        body = int(model.body_parentid[body])
-    return False
 
 
 __all__ = [
