@@ -129,10 +129,11 @@ def _rendered(case: int, distance: float, frames: int, seed: int = 0):
 
     from monopic.cases import Case
     from sim.scenario.cases import CasePlacement
+    from sim.scenario.presets import FPS
     from sim.world.ground_truth import in_image
     from sim.world.world import World
 
-    duration = frames / 15.0
+    duration = frames / FPS  # the placement's frame rate: `frames` frames
     sc = CasePlacement(
         Case(case),
         distance=distance,

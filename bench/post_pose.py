@@ -30,6 +30,7 @@ from bench.frameset import build, load
 from bench.recorder import Recorder
 from monopic.features.extractor import FeatureExtractor
 from monopic.frame import EgoState
+from monopic.horizon import HORIZON_S
 from monopic.pose.tracker import PoseTracker, TrackerConfig
 from monopic.predict.base import Mode
 from monopic.predict.registry import make_predictor
@@ -46,7 +47,7 @@ from monopic.variants.warning import CollisionWarning
 from sim.scenario.spec import CameraSpec
 
 PAPER_TREE_MS = 8.0
-HORIZON = 1.0
+HORIZON = HORIZON_S
 # (label, predictors, with robot state): the paper's image-mode predictors alone, then
 # the set every simulator run evaluates side by side (sim/runs/runner.py PREDICTORS).
 SETS = (

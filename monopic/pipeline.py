@@ -22,6 +22,7 @@ import numpy as np
 from monopic.features.extractor import DEFAULT_GROUND_COLUMN, FeatureExtractor, GroundColumn
 from monopic.features.record import Features
 from monopic.frame import EgoState, Frame
+from monopic.horizon import HORIZON_S
 from monopic.people.box import Box, pose_box
 from monopic.people.tracker import PeopleConfig, PeopleTracker
 from monopic.pose.landmarks import Pose
@@ -45,7 +46,7 @@ class Variant(StrEnum):
 
 @dataclass(frozen=True)
 class PipelineConfig:
-    horizon: float = 1.0
+    horizon: float = HORIZON_S
     mode: Mode = Mode.IMAGE
     tracker: TrackerConfig = field(default_factory=TrackerConfig)
     warning: CollisionWarning = field(default_factory=CollisionWarning)

@@ -127,7 +127,7 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--horizon",
         type=positive_float,
-        default=1.0,
+        default=PipelineConfig.horizon,
         help="seconds ahead (> 0; default %(default)g)",
     )
     p.add_argument(

@@ -12,9 +12,10 @@ within about a second even the least urgent person.
 
 from __future__ import annotations
 
+from monopic.horizon import HORIZON_S
 from monopic.people.box import Box
 
-HORIZON = 1.0  # s ahead, as the pipeline's prediction
+HORIZON = HORIZON_S  # s ahead, as the pipeline's prediction
 STALE_PER_SECOND = 2.0
 
 

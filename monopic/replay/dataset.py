@@ -23,11 +23,11 @@ import numpy as np
 from monopic.cases import Case, case_from_image_track
 from monopic.features.motion import VelocityEstimator
 from monopic.features.record import Features
+from monopic.horizon import HORIZON_S
 from monopic.predict.base import Mode
 from monopic.replay.logs import AuthorsLog
 from monopic.tree.model import TrainingSample, feature_values
 
-HORIZON_S = 1.0
 WARM_UP_S = 0.5
 
 

@@ -51,6 +51,7 @@ import numpy as np
 
 from monopic.cases import Case
 from monopic.features.record import Features
+from monopic.horizon import HORIZON_S
 from monopic.predict.base import Mode, Prediction, with_ground_point
 from monopic.tree.discretise import Discretiser
 from monopic.tree.id3 import DecisionTree, ID3Params, Node, fit_id3, information_gain
@@ -225,7 +226,7 @@ def fit_intent_model(
     samples: Sequence[IntentSample],
     discretiser: Discretiser,
     params: ID3Params | None = None,
-    horizon: float = 1.0,
+    horizon: float = HORIZON_S,
     rules: IntentRules | None = None,
     provenance: Mapping[str, Any] | None = None,
 ) -> IntentTreeModel:

@@ -29,6 +29,7 @@ import numpy as np
 
 from monopic.cases import Case
 from monopic.features.record import Features
+from monopic.horizon import HORIZON_S
 from monopic.predict.base import (
     Mode,
     Prediction,
@@ -116,7 +117,7 @@ def fit_model(
     mode: Mode = Mode.IMAGE,
     discretiser: Discretiser | str = "authors",
     params: ID3Params | None = None,
-    horizon: float = 1.0,
+    horizon: float = HORIZON_S,
     provenance: Mapping[str, Any] | None = None,
     leaf_value: LeafValue = LeafValue.DISPLACEMENT,
     shrink: float = 0.0,

@@ -19,6 +19,7 @@ from pathlib import Path
 import cv2
 
 from monopic.camera import CameraModel
+from sim.scenario import presets
 from sim.scenario.spec import MannequinSpec
 from sim.world.body import PedestrianTruth
 from sim.world.mannequin import N_LANDMARKS
@@ -30,13 +31,13 @@ from sim.world.scene import Scene, SceneConfig
 class ClipSpec:
     """A straight crossing in front of a static robot on the road."""
 
-    width: int = 768
-    height: int = 432
-    fps: float = 15.0
-    duration: float = 4.0  # s
-    vertical_fov_deg: float = 65.0
-    camera_height: float = 1.2  # m
-    pitch_deg: float = 5.0  # down
+    width: int = presets.CAMERA_WIDTH
+    height: int = presets.CAMERA_HEIGHT
+    fps: float = presets.FPS
+    duration: float = presets.DURATION_S  # s
+    vertical_fov_deg: float = presets.CAMERA_FOV_DEG
+    camera_height: float = presets.CAMERA_MOUNT_HEIGHT  # m
+    pitch_deg: float = presets.CAMERA_PITCH_DEG  # down
     robot_x: float = 0.0
     robot_y: float = -1.75  # centre of the eastbound lane
     distance: float = 2.7  # m ahead of the camera where the path crosses

@@ -27,6 +27,7 @@ from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
 from monopic.cases import GROUND_DEAD_ZONE_MPS, SECTOR_RATIO, Case
+from sim.scenario import presets
 from sim.scenario.families import PlacementError
 from sim.scenario.spec import (
     Anchor,
@@ -82,9 +83,13 @@ class CasePlacement:
     )
     lateral_offset: float = _param(0.0, -50.0, 50.0, "m", "to the left of that point")
     pedestrian_speed: float = _param(
-        1.4, GROUND_DEAD_ZONE_MPS, 10.0, "m/s", "walking speed (case 9 stands)"
+        presets.PEDESTRIAN_SPEED,
+        GROUND_DEAD_ZONE_MPS,
+        presets.MAX_PEDESTRIAN_SPEED,
+        "m/s",
+        "walking speed (case 9 stands)",
     )
-    robot_speed: float = _param(2.0, 0.0, 40.0, "m/s", "the robot's speed")
+    robot_speed: float = _param(presets.ROBOT_SPEED, 0.0, 40.0, "m/s", "the robot's speed")
     angle_deg: float = _param(
         45.0,
         OBLIQUE_RANGE_DEG[0],
@@ -99,9 +104,19 @@ class CasePlacement:
     facing_deg: float = _param(
         180.0, -360.0, 360.0, "degrees", "case 9: which way the person faces (180: the camera)"
     )
-    duration: float = _param(4.0, 0.0, 60.0, "s", "run length", open_low=True)
-    horizon: float = _param(1.0, 0.0, 10.0, "s", "warning horizon", open_low=True)
-    dt: float = _param(1.0 / 15.0, 1.0 / 60.0, 1.0, "s", "time per frame")
+    duration: float = _param(
+        presets.DURATION_S, 0.0, presets.MAX_DURATION_S, "s", "run length", open_low=True
+    )
+    horizon: float = _param(
+        presets.HORIZON_S, 0.0, presets.MAX_HORIZON_S, "s", "warning horizon", open_low=True
+    )
+    dt: float = _param(
+        1.0 / presets.FPS,
+        1.0 / presets.FPS_RANGE[1],
+        1.0 / presets.FPS_RANGE[0],
+        "s",
+        "time per frame",
+    )
     seed: int = _param(0, 0, 2**31 - 1, "", "world seed (gait phase)")
 
     def __post_init__(self) -> None:

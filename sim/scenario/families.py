@@ -20,6 +20,7 @@ from __future__ import annotations
 from dataclasses import dataclass, replace
 from enum import StrEnum
 
+from sim.scenario import presets
 from sim.scenario.spec import (
     Anchor,
     Behaviour,
@@ -56,11 +57,17 @@ class ScalePreset:
 
 
 # A small camera-carrying robot (0.6 m wide) on the right lane of a two-lane street, the
-# paper's 1 s horizon. The camera is the project's default (768x432, 65 deg, 1.2 m).
+# paper's 1 s horizon. Robot, camera and horizon are sim.scenario.presets' defaults.
 SMALL = ScalePreset(
-    robot=RobotSpec(speed=2.0, width=0.6, length=0.8, camera=CameraSpec(), max_speed=3.0),
+    robot=RobotSpec(
+        speed=presets.ROBOT_SPEED,
+        width=presets.ROBOT_WIDTH,
+        length=presets.ROBOT_LENGTH,
+        camera=CameraSpec(),
+        max_speed=3.0,
+    ),
     road=RoadLayout(lanes=2, lane_width=3.5, center_y=1.75),
-    horizon=1.0,
+    horizon=presets.HORIZON_S,
 )
 
 # A family car (1.8 m x 4.5 m) in the middle lane of a three-lane street whose nearside
@@ -221,7 +228,7 @@ def crossing_line_x(
 
 def place_crossing(
     c: Crossing, robot: RobotSpec, road: RoadLayout, speed: float, looks: MannequinSpec,
-    footprint: float = 0.5, behaviour: Behaviour | None = None,
+    footprint: float = presets.FOOTPRINT, behaviour: Behaviour | None = None,
 ) -> PedestrianSpec:  # fmt: skip
     """The pedestrian of a crossing (see Crossing), legs included for the near misses.
 
@@ -311,8 +318,8 @@ def place_crossing(
 
 
 def place_longitudinal(
-    c: Longitudinal, robot: RobotSpec, speed: float, looks: MannequinSpec, footprint: float = 0.5,
-    behaviour: Behaviour | None = None,
+    c: Longitudinal, robot: RobotSpec, speed: float, looks: MannequinSpec,
+    footprint: float = presets.FOOTPRINT, behaviour: Behaviour | None = None,
 ) -> PedestrianSpec:  # fmt: skip
     """The pedestrian of a walk along the path (see Longitudinal), walking from the start."""
     y = -robot.width / 2 + c.impact_point * robot.width
@@ -341,7 +348,7 @@ def place_longitudinal(
 
 def place_turn_in(
     c: TurnIn, robot: RobotSpec, road: RoadLayout, speed: float, looks: MannequinSpec,
-    footprint: float = 0.5, behaviour: Behaviour | None = None,
+    footprint: float = presets.FOOTPRINT, behaviour: Behaviour | None = None,
 ) -> PedestrianSpec:  # fmt: skip
     """The pedestrian of a turn-in (see TurnIn): walking from the start, one leg: the turn."""
     if not speed > 0:

@@ -22,6 +22,7 @@ import numpy as np
 
 from monopic.cases import Case
 from monopic.errors import UserError
+from sim.scenario import presets
 from sim.scenario.cases import PLACEMENT_FIELDS, CasePlacement
 from sim.scenario.families import (
     BODIES,
@@ -461,18 +462,26 @@ def build(path: Path, data: Mapping[str, Any]) -> Scenario:
     top.text("description", "")
     scale = Scale(top.text("scale", "small", tuple(s.value for s in Scale)))
     preset = SCALES[scale]
-    horizon = top.number("horizon", preset.horizon, positive=True, high=10.0, unit="s")
-    duration = top.number("duration", 4.0, positive=True, high=60.0, unit="s")
-    fps = top.number("fps", 15.0, low=1.0, high=60.0, unit="frames/s")
+    horizon = top.number(
+        "horizon", preset.horizon, positive=True, high=presets.MAX_HORIZON_S, unit="s"
+    )
+    duration = top.number(
+        "duration", presets.DURATION_S, positive=True, high=presets.MAX_DURATION_S, unit="s"
+    )
+    fps_low, fps_high = presets.FPS_RANGE
+    fps = top.number("fps", presets.FPS, low=fps_low, high=fps_high, unit="frames/s")
     seed = top.integer("seed", 0, high=2**31 - 1)
     robot = _robot(top.table("robot"), preset.robot)
     road, lighting = _scene(top.table("scene"), preset.road)
     ped_table = top.table("pedestrian")
     body = ped_table.text("body", "adult", BODIES)
     clothing = ped_table.text("clothing", "default", tuple(CLOTHING))
-    height = ped_table.number("height", None, low=0.8, high=2.2, unit="m")
-    speed = ped_table.number("speed", 1.4, low=0.0, high=10.0, unit="m/s")
-    footprint = ped_table.number("footprint", 0.5, positive=True, high=2.0, unit="m")
+    height_low, height_high = presets.HEIGHT_RANGE
+    height = ped_table.number("height", None, low=height_low, high=height_high, unit="m")
+    speed = ped_table.number(
+        "speed", presets.PEDESTRIAN_SPEED, low=0.0, high=presets.MAX_PEDESTRIAN_SPEED, unit="m/s"
+    )
+    footprint = ped_table.number("footprint", presets.FOOTPRINT, positive=True, high=2.0, unit="m")
     behaviour = _behaviour(ped_table.table("behaviour"))
     ped_table.done()
     looks = mannequin(body, clothing, height)
@@ -696,7 +705,9 @@ def _path(
             legs = tuple(
                 Leg(
                     at=leg.number("at", low=0.0, high=duration, unit="s"),
-                    speed=leg.number("speed", low=0.0, high=10.0, unit="m/s"),
+                    speed=leg.number(
+                        "speed", low=0.0, high=presets.MAX_PEDESTRIAN_SPEED, unit="m/s"
+                    ),
                     turn_deg=leg.number("turn_deg", 0.0, low=-360.0, high=360.0, unit="degrees"),
                 )
                 for leg in leg_tables

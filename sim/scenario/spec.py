@@ -15,6 +15,7 @@ from dataclasses import dataclass, field
 from monopic.camera import CameraModel
 from monopic.cases import Case
 from monopic.variants.zone import RobotGeometry
+from sim.scenario import presets
 from sim.scenario.lighting import DAY, Lighting
 
 RGB = tuple[float, float, float]
@@ -88,8 +89,9 @@ class MannequinSpec:
     shirt_pattern: str = "plain"  # "plain" or "checker" (a two-tone check of the shirt)
 
     def __post_init__(self) -> None:
-        if not 0.8 <= self.height <= 2.2:
-            raise ValueError(f"mannequin height must be in [0.8, 2.2] m, got {self.height}")
+        low, high = presets.HEIGHT_RANGE
+        if not low <= self.height <= high:
+            raise ValueError(f"mannequin height must be in [{low}, {high}] m, got {self.height}")
         if self.shirt_pattern not in ("plain", "checker"):
             raise ValueError(
                 f"shirt_pattern must be 'plain' or 'checker', got {self.shirt_pattern}"
@@ -116,11 +118,11 @@ class MannequinSpec:
 class CameraSpec:
     """The robot's forward camera."""
 
-    width: int = 768
-    height: int = 432
-    vertical_fov_deg: float = 65.0
-    mount_height: float = 1.2  # m above the ground
-    pitch_deg: float = 5.0  # positive looks down
+    width: int = presets.CAMERA_WIDTH
+    height: int = presets.CAMERA_HEIGHT
+    vertical_fov_deg: float = presets.CAMERA_FOV_DEG
+    mount_height: float = presets.CAMERA_MOUNT_HEIGHT  # m above the ground
+    pitch_deg: float = presets.CAMERA_PITCH_DEG  # positive looks down
     mount_forward: float = 0.0  # m ahead of the robot's reference point
 
     def model(self) -> CameraModel:
@@ -159,9 +161,9 @@ class BodyPitch:
 class RobotSpec:
     """The camera-carrying robot: a highway-env vehicle of this size and speed."""
 
-    speed: float = 2.0  # m/s at the start (0: standing robot)
-    width: float = 0.6  # m
-    length: float = 0.8  # m
+    speed: float = presets.ROBOT_SPEED  # m/s at the start (0: standing robot)
+    width: float = presets.ROBOT_WIDTH  # m
+    length: float = presets.ROBOT_LENGTH  # m
     camera: CameraSpec = field(default_factory=CameraSpec)
     # Limits of the longitudinal action (m/s^2) and of the speed (m/s); it never reverses.
     max_acceleration: float = 3.0
@@ -258,7 +260,7 @@ class PedestrianSpec:
     looks: MannequinSpec = field(default_factory=MannequinSpec.adult)
     legs: tuple[Leg, ...] = ()
     start_delay: float = 0.0  # s standing at the start before walking
-    footprint: float = 0.5  # m, side of the square the pedestrian occupies on the ground
+    footprint: float = presets.FOOTPRINT  # m, side of the square it occupies on the ground
     behaviour: Behaviour = field(default_factory=Behaviour)
     # Where a placement says the walker is at a time (its plan passes there then); the
     # walker is shifted to pass it exactly whatever its behaviour. None: no constraint.
@@ -287,9 +289,9 @@ class Scenario:
     scene: SceneSpec = field(default_factory=SceneSpec)
     family: str = ""
     case: Case | None = None  # the case the scenario is built to show, if any
-    duration: float = 4.0  # s
-    dt: float = 1.0 / 15.0  # s per frame (15 fps like the paper's data)
-    horizon: float = 1.0  # s, the warning horizon
+    duration: float = presets.DURATION_S  # s
+    dt: float = 1.0 / presets.FPS  # s per frame
+    horizon: float = presets.HORIZON_S  # s, the warning horizon
     seed: int = 0
 
     def __post_init__(self) -> None:

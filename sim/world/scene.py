@@ -23,7 +23,7 @@ import numpy as np
 
 from monopic.camera import CameraModel
 from sim.geometry.frames import Pose2D
-from sim.scenario.spec import MannequinSpec, Scenario, SceneSpec
+from sim.scenario.spec import CameraSpec, MannequinSpec, Scenario, SceneSpec
 from sim.world.entities.base import Entity, Moment
 from sim.world.entities.parked_car import ParkedCar
 from sim.world.entities.pedestrian import PedestrianBody
@@ -37,8 +37,8 @@ FAR_CLIP = 400.0  # m
 
 
 def default_camera() -> CameraModel:
-    """768x432, 65 degrees vertical field of view, 1.2 m high, pitched 5 degrees down."""
-    return CameraModel.from_fov(768, 432, vertical_fov_deg=65.0, mount_height=1.2, pitch_deg=5.0)
+    """The robot's default camera (sim.scenario.presets, through CameraSpec)."""
+    return CameraSpec().model()
 
 
 @dataclass(frozen=True)
