@@ -30,9 +30,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from sim.geometry.frames import wrap_angle
-from sim.scenario.path import H, Track, plan_pieces
+from sim.scenario.path import plan_pieces
 from sim.scenario.spec import Behaviour, PedestrianSpec
 from sim.scenario.stride import step_length
+from sim.scenario.track import H, Track
 
 WANDER_PERIODS = (3.0, 12.0)  # s, the speed wander's sinusoids
 WANDER_WAVELENGTHS = (2.5, 9.0)  # m, the line's sinusoids

@@ -34,8 +34,8 @@ from monopic.camera import CameraModel
 from monopic.closing import Closing
 from monopic.frame import EgoState, Frame
 from sim.geometry.frames import Pose2D, wrap_angle
-from sim.scenario.path import PathState
 from sim.scenario.spec import Scenario
+from sim.scenario.track import PathState
 from sim.world.body import PedestrianTruth, image_box
 from sim.world.ground_truth import (
     CASE_WINDOW,

@@ -11,8 +11,9 @@ from hypothesis import strategies as st
 
 from monopic.errors import UserError
 from sim.scenario.files import load
-from sim.scenario.path import H, pedestrian_path, rail_track
+from sim.scenario.path import pedestrian_path, rail_track
 from sim.scenario.spec import Anchor, Behaviour, Leg, PedestrianSpec
+from sim.scenario.track import H
 from sim.world.world import World
 from tests.paths import SCENARIOS
 
