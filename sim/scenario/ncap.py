@@ -37,7 +37,14 @@ from sim.scenario.families import (
     place_crossing,
     place_longitudinal,
 )
-from sim.scenario.spec import Behaviour, BodyPitch, RobotSpec, Scenario, SceneSpec
+from sim.scenario.spec import (
+    Behaviour,
+    BodyPitch,
+    RobotSpec,
+    Scenario,
+    SceneSpec,
+    scenario_text,
+)
 from sim.scenario.toml_table import FieldError, TomlTable, read_toml
 
 PROTOCOL_FILE = Path("scenarios/ncap/protocol.toml")
@@ -457,7 +464,7 @@ def _check_road(protocol: Protocol, s: Scenario) -> None:
 
 def scenario_digest(s: Scenario) -> str:
     """8 hex digits of the complete scenario (a run's identity, as sweeps use)."""
-    return hashlib.sha1(repr(replace(s, name="", seed=0)).encode()).hexdigest()[:8]
+    return hashlib.sha1(scenario_text(replace(s, name="", seed=0)).encode()).hexdigest()[:8]
 
 
 def describe(protocol: Protocol, car: CarSpec) -> dict[str, Any]:

@@ -302,3 +302,9 @@ class Scenario:
     @property
     def frames(self) -> int:
         return int(round(self.duration / self.dt))
+
+
+def scenario_text(s: Scenario) -> str:
+    """The text a scenario's identity digests: sweep run ids (and so their seeds), Euro NCAP
+    and closed-loop run ids. Its repr: any change of the scenario is another run."""
+    return repr(s)
