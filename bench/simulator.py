@@ -46,10 +46,10 @@ def scenario(
 
     from monopic.cases import Case
     from sim.scenario.cases import CasePlacement
-    from sim.scenario.spec import Behaviour
+    from sim.scenario.walkers import WALKERS
 
     placement = CasePlacement(Case(case), duration=frames / REALTIME_FPS, seed=seed)
-    sc = placement.scenario(behaviour=Behaviour(model=model))
+    sc = placement.scenario(behaviour=WALKERS[model]())
     return replace(sc, scene=replace(sc.scene, shadows=shadows))
 
 

@@ -30,13 +30,13 @@ from monopic.cases import GROUND_DEAD_ZONE_MPS, SECTOR_RATIO, Case
 from sim.scenario.families import PlacementError
 from sim.scenario.spec import (
     Anchor,
-    Behaviour,
     MannequinSpec,
     PedestrianSpec,
     RobotSpec,
     Scenario,
     SceneSpec,
 )
+from sim.scenario.walkers import RailWalker, Walker
 
 OBLIQUE_RANGE_DEG = (
     math.degrees(math.atan(SECTOR_RATIO)),
@@ -132,7 +132,7 @@ class CasePlacement:
         robot: RobotSpec | None = None,
         scene: SceneSpec | None = None,
         name: str | None = None,
-        behaviour: Behaviour | None = None,
+        behaviour: Walker | None = None,
     ) -> Scenario:
         """The scenario: `robot` gives the robot's size, camera and limits (its speed is
         replaced by robot_speed); `looks` the mannequin (default adult)."""
@@ -146,7 +146,7 @@ class CasePlacement:
             heading_deg=heading,
             speed=speed,
             looks=looks or MannequinSpec.adult(),
-            behaviour=behaviour or Behaviour(),
+            behaviour=behaviour or RailWalker(),
             anchor=Anchor(meet, self.distance, self.lateral_offset) if speed > 0 else None,
         )
         return Scenario(

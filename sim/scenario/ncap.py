@@ -38,7 +38,6 @@ from sim.scenario.families import (
     place_longitudinal,
 )
 from sim.scenario.spec import (
-    Behaviour,
     BodyPitch,
     RobotSpec,
     Scenario,
@@ -46,6 +45,7 @@ from sim.scenario.spec import (
     scenario_text,
 )
 from sim.scenario.toml_table import FieldError, TomlTable, read_toml
+from sim.scenario.walkers import RailWalker
 
 PROTOCOL_FILE = Path("scenarios/ncap/protocol.toml")
 CAR_FILE = Path("scenarios/ncap/car.toml")
@@ -408,7 +408,7 @@ def scenario_for(
     road = replace(CAR.road, length=protocol.street.road_length, crosswalk_x=None)
     speed = (test.target_speed_kmh + d.target_speed_kmh) * KMH
     looks = mannequin(test.body, "default")
-    behaviour = Behaviour(model="rail", acceleration_distance=test.acceleration_distance)
+    behaviour = RailWalker(acceleration_distance=test.acceleration_distance)
     timing = protocol.timing
     impact_time = timing.impact_time
     # The car's own lateral deviation moves the target the other way relative to it.

@@ -3,8 +3,8 @@
 A Track is vertices (t_k, p_k) joined by straight pieces at constant velocity, the last
 piece going on for ever. The body (MuJoCo), highway-env's road object and the ground
 truth all read the same Track, so the truth's case of the next second, its collisions and
-times to contact use exactly the motion the body makes. The walks (sim.scenario.path,
-sim.scenario.human) make Tracks; this module knows nothing of them.
+times to contact use exactly the motion the body makes. Walkers (sim.scenario.walkers)
+make Tracks; this module knows nothing of them.
 """
 
 from __future__ import annotations

@@ -11,13 +11,15 @@ from hypothesis import strategies as st
 
 from monopic.errors import UserError
 from sim.scenario.files import load
-from sim.scenario.path import pedestrian_path, rail_track
-from sim.scenario.spec import Anchor, Behaviour, Leg, PedestrianSpec
+from sim.scenario.path import pedestrian_path
+from sim.scenario.plan import rail_track
+from sim.scenario.spec import Anchor, Leg, PedestrianSpec
 from sim.scenario.track import H
+from sim.scenario.walkers import HumanWalker, RailWalker
 from sim.world.world import World
 from tests.paths import SCENARIOS
 
-HUMAN = Behaviour(model="human")
+HUMAN = HumanWalker()
 
 
 def speeds(track, t0: float, t1: float, dt: float = H) -> tuple[np.ndarray, np.ndarray]:
@@ -42,7 +44,7 @@ def test_the_rail_target_reaches_its_speed_over_the_acceleration_distance():
 
 def test_an_anchor_is_met_exactly_by_both_behaviours():
     anchor = Anchor(time=3.0, x=4.0, y=0.5)
-    for behaviour in (Behaviour(), HUMAN):
+    for behaviour in (RailWalker(), HUMAN):
         spec = PedestrianSpec(x=4.0, y=-3.0, heading_deg=90.0, speed=1.39, start_delay=0.5,
                               behaviour=behaviour, anchor=anchor)  # fmt: skip
         for seed in (0, 1, 2):
@@ -83,10 +85,9 @@ def test_a_human_stops_exactly_where_the_plan_stops_and_over_about_a_second():
 
 
 def test_a_human_turns_along_an_arc_at_a_bounded_yaw_rate():
-    spec = PedestrianSpec(x=0.0, y=-4.0, heading_deg=90.0, speed=1.4,
-                          legs=(Leg(at=2.0, speed=1.4, turn_deg=-90.0),),
-                          behaviour=Behaviour(model="human", lateral_wander=0.0, sway=0.0,
-                                              surge=0.0))  # fmt: skip
+    walker = HumanWalker(lateral_wander=0.0, sway=0.0, surge=0.0)
+    turn = (Leg(at=2.0, speed=1.4, turn_deg=-90.0),)
+    spec = PedestrianSpec(x=0.0, y=-4.0, heading_deg=90.0, speed=1.4, legs=turn, behaviour=walker)
     track = pedestrian_path(spec, 6.0, seed=0)
     times = np.arange(0.0, 5.0, 0.05)
     yaws = np.unwrap([track.state(float(t)).yaw for t in times])
@@ -183,14 +184,14 @@ def test_every_collision_and_near_miss_family_has_a_human_version():
             assert scenario.pedestrian.behaviour.model == model
 
 
-# -- intent cues (issue 18) ---------------------------------------------------------------
+# -- intent cues ---------------------------------------------------------------
 
 NO_CUES = {"head_check_probability": 0.0, "turn_lead": 0.0, "stop_lead": 0.0}
 
 
 def crossing_spec(**behaviour: float) -> PedestrianSpec:
     return PedestrianSpec(x=4.0, y=-4.0, heading_deg=90.0, speed=1.4, start_delay=2.0,
-                          behaviour=Behaviour(model="human", **behaviour))  # fmt: skip
+                          behaviour=HumanWalker(**behaviour))  # fmt: skip
 
 
 def test_cues_off_reproduce_the_cue_free_walker_exactly():
@@ -213,8 +214,8 @@ def test_a_head_check_looks_toward_the_traffic_before_stepping_off_and_at_a_stop
     assert max(turned) == pytest.approx(math.radians(60.0), abs=math.radians(1.0))
     stop = PedestrianSpec(x=4.0, y=-4.0, heading_deg=90.0, speed=1.4, start_delay=1.0,
                           legs=(Leg(at=3.0, speed=0.0),),
-                          behaviour=Behaviour(model="human", head_check_probability=1.0,
-                                              head_check_interval=0.0))  # fmt: skip
+                          behaviour=HumanWalker(head_check_probability=1.0,
+                                                head_check_interval=0.0))  # fmt: skip
     track = pedestrian_path(stop, 8.0, 7)
     t, v = speeds(track, 0.0, 8.0, dt=0.05)
     arrived = t[np.flatnonzero(v > 0.05)[-1]]
@@ -223,9 +224,7 @@ def test_a_head_check_looks_toward_the_traffic_before_stepping_off_and_at_a_stop
 
 
 def test_the_head_then_the_shoulders_lead_a_turn():
-    quiet = Behaviour(
-        model="human", head_check_probability=0.0, turn_lead=0.5, lateral_wander=0.0, sway=0.0
-    )
+    quiet = HumanWalker(head_check_probability=0.0, turn_lead=0.5, lateral_wander=0.0, sway=0.0)
     turn = (Leg(at=2.0, speed=1.4, turn_deg=90.0),)
     spec = PedestrianSpec(x=0.0, y=-4.0, heading_deg=0.0, speed=1.4, legs=turn, behaviour=quiet)
     track = pedestrian_path(spec, 6.0, 0)
