@@ -47,10 +47,10 @@ def scenario(
     from monopic.cases import Case
     from sim.scenario.cases import CasePlacement
     from sim.scenario.lighting import PRESETS
-    from sim.scenario.spec import Behaviour
+    from sim.scenario.walkers import WALKERS
 
     placement = CasePlacement(Case(case), duration=frames / REALTIME_FPS, seed=seed)
-    sc = placement.scenario(behaviour=Behaviour(model=model))
+    sc = placement.scenario(behaviour=WALKERS[model]())
     if shadows:
         return sc
     sun = sc.scene.lighting.sun  # the same sun behind clouds

@@ -321,7 +321,7 @@ def write_report(
         *triage_lines(m, rows, Rerunning.of(results, out_dir)),
         "## By pedestrian behaviour and intent cues",
         "",
-        "Walker model (`rail`: the Euro NCAP target; `human`: sim/scenario/human.py) and",
+        "Walker model (`rail`: the Euro NCAP target; `human`: sim/scenario/walkers/human.py) and",
         "whether it showed intent cues (head checks, head and shoulders leading turns, slowing",
         "before a stop). Nuisance warnings: warning onsets while no contact is ahead at all, per",
         "hour of such time with the pedestrian in view. Flicker: warnings that come back within",

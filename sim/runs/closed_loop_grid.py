@@ -34,7 +34,7 @@ from sim.runs.results_file import check_resumable, without_keys
 from sim.runs.runner import machine
 from sim.runs.sweep import SweepOutcome, rows_of, run_resumable
 from sim.scenario.files import Given, ScenarioFile, load, placed_case
-from sim.scenario.spec import Scenario
+from sim.scenario.spec import Scenario, scenario_text
 from sim.world.render import KeptRenderContext
 
 SCHEMA = 1
@@ -177,7 +177,7 @@ class LoopRun:
 
 def run_digest(scenario: Scenario, policy: str, latency: LatencySetting) -> str:
     """8 hex digits of the scenario (seed included), the policy and the latency setting."""
-    text = f"{replace(scenario, name='')!r}|{policy}|{latency.to_json()}"
+    text = f"{scenario_text(replace(scenario, name=''))}|{policy}|{latency.to_json()}"
     return hashlib.sha1(text.encode()).hexdigest()[:8]
 
 

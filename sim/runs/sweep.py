@@ -52,7 +52,7 @@ from sim.scenario.files import (
     parse_parameters,
     unsweepable,
 )
-from sim.scenario.spec import Scenario
+from sim.scenario.spec import Scenario, scenario_text
 from sim.scenario.toml_table import TomlTable, read_toml
 
 INCLUDE_SAMPLING = ("file", "base", "grid", "random")
@@ -197,7 +197,7 @@ def run_scenario(file: ScenarioFile, params: Mapping[str, Any]) -> tuple[Scenari
     digest of that (the last part of its run id): what `monopic rerun` rebuilds a run with."""
     built = file.scenario(params, name=file.name)
     probe = replace(built, seed=0)
-    return built, probe, hashlib.sha1(repr(probe).encode()).hexdigest()[:8]
+    return built, probe, hashlib.sha1(scenario_text(probe).encode()).hexdigest()[:8]
 
 
 def run_seed(file: ScenarioFile, digest: str, seed: int) -> int:

@@ -31,13 +31,13 @@ from sim.scenario import presets
 from sim.scenario.families import PlacementError
 from sim.scenario.spec import (
     Anchor,
-    Behaviour,
     MannequinSpec,
     PedestrianSpec,
     RobotSpec,
     Scenario,
     SceneSpec,
 )
+from sim.scenario.walkers import RailWalker, Walker
 
 OBLIQUE_RANGE_DEG = (
     math.degrees(math.atan(SECTOR_RATIO)),
@@ -147,7 +147,7 @@ class CasePlacement:
         robot: RobotSpec | None = None,
         scene: SceneSpec | None = None,
         name: str | None = None,
-        behaviour: Behaviour | None = None,
+        behaviour: Walker | None = None,
     ) -> Scenario:
         """The scenario: `robot` gives the robot's size, camera and limits (its speed is
         replaced by robot_speed); `looks` the mannequin (default adult)."""
@@ -161,7 +161,7 @@ class CasePlacement:
             heading_deg=heading,
             speed=speed,
             looks=looks or MannequinSpec.adult(),
-            behaviour=behaviour or Behaviour(),
+            behaviour=behaviour or RailWalker(),
             anchor=Anchor(meet, self.distance, self.lateral_offset) if speed > 0 else None,
         )
         return Scenario(

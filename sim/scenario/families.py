@@ -23,7 +23,6 @@ from enum import StrEnum
 from sim.scenario import presets
 from sim.scenario.spec import (
     Anchor,
-    Behaviour,
     CameraSpec,
     Leg,
     MannequinSpec,
@@ -32,6 +31,7 @@ from sim.scenario.spec import (
     RoadLayout,
     RobotSpec,
 )
+from sim.scenario.walkers import RailWalker, Walker
 
 # Clearance between the pedestrian and the kerb line when it stops or turns there.
 KERB_STOP_GAP = 0.2  # m
@@ -228,20 +228,18 @@ def crossing_line_x(
 
 def place_crossing(
     c: Crossing, robot: RobotSpec, road: RoadLayout, speed: float, looks: MannequinSpec,
-    footprint: float = presets.FOOTPRINT, behaviour: Behaviour | None = None,
+    footprint: float = presets.FOOTPRINT, behaviour: Walker | None = None,
 ) -> PedestrianSpec:  # fmt: skip
     """The pedestrian of a crossing (see Crossing), legs included for the near misses.
 
-    The plan is the rail target's: standing, then accelerating over the acceleration
-    distance (the behaviour's, else the protocol's for the side) and walking on at speed;
-    it passes the impact point at impact_time (the anchor), having walked `approach`
-    metres from where it stood. A human walker meets the same anchor its own way.
+    The plan is the rail target's: standing, then accelerating over the walker's start
+    distance (the rail target's own acceleration distance, else the protocol's for the
+    side) and walking on at speed; it passes the impact point at impact_time (the anchor),
+    having walked `approach` metres from where it stood. A human walker (start distance
+    0) meets the same anchor its own way.
     """
-    behaviour = behaviour or Behaviour()
-    if behaviour.acceleration_distance is None:
-        behaviour = replace(behaviour, acceleration_distance=ACCELERATION_DISTANCE[c.side.value])
-    accel = behaviour.acceleration_distance if behaviour.model == "rail" else 0.0
-    assert accel is not None
+    behaviour = (behaviour or RailWalker()).placed(ACCELERATION_DISTANCE[c.side.value])
+    accel = behaviour.start_distance
     if not speed > 0:
         raise PlacementError("pedestrian.speed", speed, "a crossing pedestrian must walk (> 0 m/s)")
     if accel > c.approach:
@@ -319,7 +317,7 @@ def place_crossing(
 
 def place_longitudinal(
     c: Longitudinal, robot: RobotSpec, speed: float, looks: MannequinSpec,
-    footprint: float = presets.FOOTPRINT, behaviour: Behaviour | None = None,
+    footprint: float = presets.FOOTPRINT, behaviour: Walker | None = None,
 ) -> PedestrianSpec:  # fmt: skip
     """The pedestrian of a walk along the path (see Longitudinal), walking from the start."""
     y = -robot.width / 2 + c.impact_point * robot.width
@@ -341,14 +339,14 @@ def place_longitudinal(
         speed=speed,
         looks=looks,
         footprint=footprint,
-        behaviour=behaviour or Behaviour(),
+        behaviour=behaviour or RailWalker(),
         anchor=anchor,
     )
 
 
 def place_turn_in(
     c: TurnIn, robot: RobotSpec, road: RoadLayout, speed: float, looks: MannequinSpec,
-    footprint: float = presets.FOOTPRINT, behaviour: Behaviour | None = None,
+    footprint: float = presets.FOOTPRINT, behaviour: Walker | None = None,
 ) -> PedestrianSpec:  # fmt: skip
     """The pedestrian of a turn-in (see TurnIn): walking from the start, one leg: the turn."""
     if not speed > 0:
@@ -376,7 +374,7 @@ def place_turn_in(
         looks=looks,
         legs=(Leg(t_turn, speed, turn),),
         footprint=footprint,
-        behaviour=behaviour or Behaviour(),
+        behaviour=behaviour or RailWalker(),
         anchor=Anchor(c.impact_time, x_line, y_impact),
     )
 

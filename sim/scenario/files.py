@@ -49,8 +49,6 @@ from sim.scenario.lighting import FILE_DEFAULT, Lighting
 from sim.scenario.lighting import PRESETS as LIGHTING
 from sim.scenario.path import pedestrian_path
 from sim.scenario.spec import (
-    BEHAVIOURS,
-    Behaviour,
     BodyPitch,
     CameraSpec,
     Leg,
@@ -62,6 +60,7 @@ from sim.scenario.spec import (
     SceneSpec,
 )
 from sim.scenario.toml_table import MISSING, FieldError, TomlTable, read_toml, show
+from sim.scenario.walkers import Walker, walker_from_table
 
 KINDS = ("case", "collision", "near-miss")
 PATH_KINDS = ("case", "crossing", "longitudinal", "turn-in", "explicit")
@@ -482,7 +481,7 @@ def build(path: Path, data: Mapping[str, Any]) -> Scenario:
         "speed", presets.PEDESTRIAN_SPEED, low=0.0, high=presets.MAX_PEDESTRIAN_SPEED, unit="m/s"
     )
     footprint = ped_table.number("footprint", presets.FOOTPRINT, positive=True, high=2.0, unit="m")
-    behaviour = _behaviour(ped_table.table("behaviour"))
+    behaviour = walker_from_table(ped_table.table("behaviour"))  # scenarios/README.md
     ped_table.done()
     looks = mannequin(body, clothing, height)
     path_table = top.table("path")
@@ -506,50 +505,6 @@ def build(path: Path, data: Mapping[str, Any]) -> Scenario:
     )
     _check_on_street(path, scenario)
     return scenario
-
-
-def _behaviour(t: TomlTable) -> Behaviour:
-    """[pedestrian.behaviour]: the walker model and its parameters (scenarios/README.md)."""
-    base = Behaviour()
-    model = t.text("model", base.model, BEHAVIOURS)
-    if model == "rail":
-        distance = t.number("acceleration_distance", None, low=0.0, high=10.0, unit="m")
-        t.done()
-        return Behaviour(model=model, acceleration_distance=distance)
-    behaviour = Behaviour(
-        model=model,
-        start_time=t.number("start_time", base.start_time, low=0.2, high=5.0, unit="s"),
-        stop_time=t.number("stop_time", base.stop_time, low=0.2, high=5.0, unit="s"),
-        max_yaw_rate=t.number(
-            "max_yaw_rate", base.max_yaw_rate, low=10.0, high=360.0, unit="deg/s"
-        ),  # fmt: skip
-        speed_wander=t.number("speed_wander", base.speed_wander, low=0.0, high=0.3),
-        lateral_wander=t.number(
-            "lateral_wander", base.lateral_wander, low=0.0, high=0.5, unit="m"
-        ),  # fmt: skip
-        sway=t.number("sway", base.sway, low=0.0, high=0.1, unit="m"),
-        surge=t.number("surge", base.surge, low=0.0, high=0.3),
-        head_check_probability=t.number(
-            "head_check_probability", base.head_check_probability, low=0.0, high=1.0
-        ),
-        head_check_lead=t.number(
-            "head_check_lead", base.head_check_lead, low=0.0, high=5.0, unit="s"
-        ),  # fmt: skip
-        head_check_duration=t.number(
-            "head_check_duration", base.head_check_duration, low=0.2, high=5.0, unit="s"
-        ),  # fmt: skip
-        head_check_amplitude=t.number(
-            "head_check_amplitude", base.head_check_amplitude, low=0.0, high=120.0, unit="deg"
-        ),  # fmt: skip
-        head_check_interval=t.number(
-            "head_check_interval", base.head_check_interval, low=0.0, high=30.0, unit="s"
-        ),  # fmt: skip
-        torso_share=t.number("torso_share", base.torso_share, low=0.0, high=1.0),
-        turn_lead=t.number("turn_lead", base.turn_lead, low=0.0, high=2.0, unit="s"),
-        stop_lead=t.number("stop_lead", base.stop_lead, low=0.0, high=3.0, unit="s"),
-    )
-    t.done()
-    return behaviour
 
 
 def _robot(t: TomlTable, preset: RobotSpec) -> RobotSpec:
@@ -644,7 +599,7 @@ def _path(
     looks: Any,
     footprint: float,
     duration: float,
-    behaviour: Behaviour,
+    behaviour: Walker,
 ) -> tuple[PedestrianSpec, Case | None, float | None]:
     """The pedestrian's path; also its case and (crossings) the crossing line's x."""
     kind = t.text("kind", choices=PATH_KINDS)
@@ -740,7 +695,7 @@ PATH_PLACEMENT = ("distance", "lateral_offset", "angle_deg", "meet_time", "facin
 
 def _case_path(
     t: TomlTable, robot: RobotSpec, speed: float, looks: Any, footprint: float, duration: float,
-    behaviour: Behaviour,
+    behaviour: Walker,
 ) -> tuple[PedestrianSpec, Case]:  # fmt: skip
     """sim.scenario.cases.CasePlacement: the path passes (distance, offset) at meet_time."""
     case = Case(t.integer("case", low=1, high=9))

@@ -37,8 +37,15 @@ from sim.scenario.families import (
     place_crossing,
     place_longitudinal,
 )
-from sim.scenario.spec import Behaviour, BodyPitch, RobotSpec, Scenario, SceneSpec
+from sim.scenario.spec import (
+    BodyPitch,
+    RobotSpec,
+    Scenario,
+    SceneSpec,
+    scenario_text,
+)
 from sim.scenario.toml_table import FieldError, TomlTable, read_toml
+from sim.scenario.walkers import RailWalker
 
 PROTOCOL_FILE = Path("scenarios/ncap/protocol.toml")
 CAR_FILE = Path("scenarios/ncap/car.toml")
@@ -401,7 +408,7 @@ def scenario_for(
     road = replace(CAR.road, length=protocol.street.road_length, crosswalk_x=None)
     speed = (test.target_speed_kmh + d.target_speed_kmh) * KMH
     looks = mannequin(test.body, "default")
-    behaviour = Behaviour(model="rail", acceleration_distance=test.acceleration_distance)
+    behaviour = RailWalker(acceleration_distance=test.acceleration_distance)
     timing = protocol.timing
     impact_time = timing.impact_time
     # The car's own lateral deviation moves the target the other way relative to it.
@@ -457,7 +464,7 @@ def _check_road(protocol: Protocol, s: Scenario) -> None:
 
 def scenario_digest(s: Scenario) -> str:
     """8 hex digits of the complete scenario (a run's identity, as sweeps use)."""
-    return hashlib.sha1(repr(replace(s, name="", seed=0)).encode()).hexdigest()[:8]
+    return hashlib.sha1(scenario_text(replace(s, name="", seed=0)).encode()).hexdigest()[:8]
 
 
 def describe(protocol: Protocol, car: CarSpec) -> dict[str, Any]:

@@ -10,13 +10,15 @@ The robot starts at the origin heading east along the road's lane.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from monopic.camera import CameraModel
 from monopic.cases import Case
 from monopic.variants.zone import RobotGeometry
 from sim.scenario import presets
-from sim.scenario.lighting import DAY, Lighting
+from sim.scenario.lighting import DAY, PRESETS, Lighting
+from sim.scenario.plan import Anchor, Leg
+from sim.scenario.walkers import RailWalker, Walker
 
 RGB = tuple[float, float, float]
 
@@ -177,79 +179,6 @@ class RobotSpec:
 
 
 @dataclass(frozen=True)
-class Leg:
-    """One piece of the pedestrian's path after the start.
-
-    From `at` seconds after the start, walk at `speed` (0: stand still) with the heading
-    turned by `turn_deg` (counter-clockwise) relative to the previous leg. The start is
-    the scenario's t = 0 (start_delay does not shift legs; see sim.world.pedestrian).
-    """
-
-    at: float
-    speed: float
-    turn_deg: float = 0.0
-
-
-BEHAVIOURS = ("rail", "human")
-
-
-@dataclass(frozen=True)
-class Behaviour:
-    """How the pedestrian walks its planned path (scenarios/README.md: units, ranges, sources).
-
-    `rail` is the Euro NCAP pedestrian target: from standing it reaches its speed over
-    `acceleration_distance` at constant acceleration, then moves on straight lines at
-    constant speed; the legs' stops and turns are instant. `human` walks the same plan as
-    a person: starts and stops over a couple of steps (raised-cosine speed profiles),
-    turns along arcs at a bounded yaw rate, and wanders a little in speed and sideways.
-    A placed scenario's `PedestrianSpec.anchor` is honoured by both: the walker passes
-    the anchor point at the anchor time, however it starts.
-    """
-
-    model: str = "rail"
-    # rail: m from standing to speed; None: the placement's default (Euro NCAP AEB VRU
-    # protocol: 1.0 m for near-side targets, 1.5 m for far-side ones).
-    acceleration_distance: float | None = None
-    # human (defaults and their sources in scenarios/README.md):
-    start_time: float = 1.8  # s from standing to walking speed (about three steps)
-    stop_time: float = 1.2  # s from walking speed to standing (about two steps)
-    max_yaw_rate: float = 90.0  # deg/s along a turn
-    speed_wander: float = 0.10  # amplitude of the speed's slow wander, share of its speed
-    lateral_wander: float = 0.15  # m, amplitude of the sideways wander off the plan's line
-    sway: float = 0.02  # m, the body's side-to-side sway once a stride
-    surge: float = 0.12  # the body's speed rising and falling twice a stride, share of it
-    # human intent cues (probability 0 and lead times 0: a walker without them, exactly):
-    head_check_probability: float = 0.8  # of each head check toward the traffic
-    head_check_lead: float = 1.0  # s before setting off that the check before it begins
-    head_check_duration: float = 0.8  # s, out and back
-    head_check_amplitude: float = 60.0  # deg of head yaw (the shoulders turn torso_share of it)
-    head_check_interval: float = 1.5  # s between checks while walking or standing
-    torso_share: float = 0.3  # of a head turn the shoulders follow
-    turn_lead: float = 0.4  # s the head leads the walking line in turns (shoulders half of it)
-    stop_lead: float = 0.6  # s of slowing to STOP_APPROACH of the speed before braking to a stop
-
-    def __post_init__(self) -> None:
-        if self.model not in BEHAVIOURS:
-            raise ValueError(f"behaviour model must be one of {', '.join(BEHAVIOURS)}")
-
-    @property
-    def cues(self) -> bool:
-        """Whether this walker shows intent cues (rail targets never do)."""
-        return self.model == "human" and (
-            self.head_check_probability > 0 or self.turn_lead > 0 or self.stop_lead > 0
-        )
-
-
-@dataclass(frozen=True)
-class Anchor:
-    """A point the walker passes at a given time (the placement solved for it)."""
-
-    time: float  # s from the start
-    x: float  # world, m
-    y: float
-
-
-@dataclass(frozen=True)
 class PedestrianSpec:
     """The mannequin (stature, clothing) and its path: start, heading, speed, then legs."""
 
@@ -261,7 +190,8 @@ class PedestrianSpec:
     legs: tuple[Leg, ...] = ()
     start_delay: float = 0.0  # s standing at the start before walking
     footprint: float = presets.FOOTPRINT  # m, side of the square it occupies on the ground
-    behaviour: Behaviour = field(default_factory=Behaviour)
+    # How it walks the plan (sim.scenario.walkers; the file's [pedestrian.behaviour]).
+    behaviour: Walker = field(default_factory=RailWalker)
     # Where a placement says the walker is at a time (its plan passes there then); the
     # walker is shifted to pass it exactly whatever its behaviour. None: no constraint.
     anchor: Anchor | None = None
@@ -303,3 +233,38 @@ class Scenario:
     @property
     def frames(self) -> int:
         return int(round(self.duration / self.dt))
+
+
+def scenario_text(s: Scenario) -> str:
+    """The text a scenario's identity digests: sweep run ids (and so their seeds), Euro NCAP
+    and closed-loop run ids. Its repr, the walker written as its identity (Walker.identity)
+    and the scene as its own (scene_identity): any change of the scenario is another run,
+    and a new layout of the records is not."""
+    walker = _Written(s.pedestrian.behaviour.identity())
+    scene = _Written(scene_identity(s.scene))
+    return repr(replace(s, pedestrian=replace(s.pedestrian, behaviour=walker), scene=scene))
+
+
+def scene_identity(scene: SceneSpec) -> str:
+    """The scene as run identities have always written it: the sun's azimuth, elevation and
+    shadows where a Lighting now stands, for every lighting that is a preset with its sun
+    (perhaps moved); any other lighting in full."""
+    light = scene.lighting
+    preset = PRESETS.get(light.name)
+    sun = light.sun
+    if preset is None or light != preset.with_sun(sun.azimuth_deg, sun.elevation_deg):
+        return repr(scene)
+    return (
+        f"SceneSpec(occluders={scene.occluders!r}, sun_azimuth_deg={sun.azimuth_deg!r}, "
+        f"sun_elevation_deg={sun.elevation_deg!r}, shadows={sun.shadows!r}, road={scene.road!r})"
+    )
+
+
+@dataclass(frozen=True)
+class _Written:
+    """A text that reprs as itself (a walker's identity inside the scenario's repr)."""
+
+    text: str
+
+    def __repr__(self) -> str:
+        return self.text

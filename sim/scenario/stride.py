@@ -4,7 +4,7 @@ Dynamic similarity: bodies of different size walking at the same Froude number t
 the same shape of stride, so step length scales with stature and grows with the square
 root of the size-normalised speed. An adult (1.8 m) at a comfortable 1.4 m/s takes about
 1.8 steps per second. The mannequin's gait (sim.world.gait) and the human walker's
-stride-level motion (sim.scenario.human) both use it, so legs and body move together.
+stride-level motion (sim.scenario.walkers.human) both use it, so legs and body move together.
 """
 
 from __future__ import annotations

@@ -5,7 +5,7 @@ Everything is in the robot's frame at the labelled time: the robot keeps its cou
 its path is the line ahead along its current heading, and a pedestrian's side of it is
 the sign of their lateral position (+ left) now.
 
-Four classes, from the pedestrian's true Track (sim.scenario.path) over (t, t + horizon]:
+Four classes, from the pedestrian's true Track (sim.scenario.track) over (t, t + horizon]:
 
 - stop: moving now (own ground speed at least the dead zone, monopic.cases'
   GROUND_DEAD_ZONE_MPS) and the speed falls below it within the horizon. Read on the
@@ -44,7 +44,7 @@ import numpy as np
 
 from monopic.cases import GROUND_DEAD_ZONE_MPS, Case, case_from_ground_velocity
 from sim.geometry.frames import Pose2D
-from sim.scenario.path import Track
+from sim.scenario.track import Track
 
 ON_CENTRE_M = 1e-3  # m: closer to the centre line than this, the pedestrian has no side
 

@@ -16,8 +16,9 @@ from highway_env.road.road import Road
 from highway_env.vehicle.objects import RoadObject
 
 from sim.geometry.highway_frame import reflect, world_to_highway
-from sim.scenario.path import PathState, pedestrian_path
+from sim.scenario.path import pedestrian_path
 from sim.scenario.spec import PedestrianSpec
+from sim.scenario.track import PathState
 from sim.world.gait import Gait
 
 

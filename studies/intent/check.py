@@ -26,7 +26,7 @@ from monopic.predict.constant_velocity import ConstantVelocityPredictor
 from sim.runs.pipelines import scenario_pipeline
 from sim.scenario.cases import CasePlacement
 from sim.scenario.files import load
-from sim.scenario.spec import Behaviour
+from sim.scenario.walkers import WALKERS, HumanWalker
 from sim.world.world import World
 
 ROOT = Path(__file__).resolve().parents[2]
@@ -42,8 +42,8 @@ def labels(families: list[str]) -> None:
     for name in families:
         for model in ("rail", "human"):
             sc = load(FAMILIES / f"{name}.toml").scenario({}, name)
-            behaviour = replace(sc.pedestrian.behaviour, model=model)
-            sc = replace(sc, pedestrian=replace(sc.pedestrian, behaviour=behaviour))
+            if sc.pedestrian.behaviour.model != model:  # the family's plan, the other walker
+                sc = replace(sc, pedestrian=replace(sc.pedestrian, behaviour=WALKERS[model]()))
             changes, previous = [], None
             with World(sc, render=False) as world:
                 for step in world.run():
@@ -59,7 +59,7 @@ def labels(families: list[str]) -> None:
 
 def features(case: Case, robot_speed: float) -> None:
     """Print the head yaw and ground kinematics errors of one rendered run."""
-    behaviour = Behaviour(model="human", head_check_probability=1.0, head_check_interval=1.0)
+    behaviour = HumanWalker(head_check_probability=1.0, head_check_interval=1.0)
     placement = CasePlacement(case, distance=8.0, duration=4.0, robot_speed=robot_speed)
     sc = placement.scenario(behaviour=behaviour)
     pipe = scenario_pipeline(sc, [ConstantVelocityPredictor(mode=Mode.GROUND)])

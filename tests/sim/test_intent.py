@@ -9,7 +9,7 @@ import pytest
 
 from monopic.cases import Case
 from sim.geometry.frames import Pose2D
-from sim.scenario.path import Track
+from sim.scenario.track import Track
 from sim.world.intent import Intent, IntentConfig, first_slow_time, intent_label
 
 H = 0.01

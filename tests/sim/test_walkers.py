@@ -3,6 +3,9 @@
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass, fields
+from pathlib import Path
+from typing import ClassVar
 
 import numpy as np
 import pytest
@@ -10,13 +13,18 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from monopic.errors import UserError
+from sim.runs.sweep import run_scenario
 from sim.scenario.files import load
-from sim.scenario.path import H, pedestrian_path, rail_track
-from sim.scenario.spec import Anchor, Behaviour, Leg, PedestrianSpec
+from sim.scenario.path import pedestrian_path
+from sim.scenario.plan import rail_track
+from sim.scenario.spec import Anchor, Leg, PedestrianSpec, scenario_text
+from sim.scenario.toml_table import FieldError, TomlTable
+from sim.scenario.track import H, Track
+from sim.scenario.walkers import WALKERS, HumanWalker, RailWalker, Walker, walker_from_table
 from sim.world.world import World
 from tests.paths import SCENARIOS
 
-HUMAN = Behaviour(model="human")
+HUMAN = HumanWalker()
 
 
 def speeds(track, t0: float, t1: float, dt: float = H) -> tuple[np.ndarray, np.ndarray]:
@@ -41,7 +49,7 @@ def test_the_rail_target_reaches_its_speed_over_the_acceleration_distance():
 
 def test_an_anchor_is_met_exactly_by_both_behaviours():
     anchor = Anchor(time=3.0, x=4.0, y=0.5)
-    for behaviour in (Behaviour(), HUMAN):
+    for behaviour in (RailWalker(), HUMAN):
         spec = PedestrianSpec(x=4.0, y=-3.0, heading_deg=90.0, speed=1.39, start_delay=0.5,
                               behaviour=behaviour, anchor=anchor)  # fmt: skip
         for seed in (0, 1, 2):
@@ -82,10 +90,9 @@ def test_a_human_stops_exactly_where_the_plan_stops_and_over_about_a_second():
 
 
 def test_a_human_turns_along_an_arc_at_a_bounded_yaw_rate():
-    spec = PedestrianSpec(x=0.0, y=-4.0, heading_deg=90.0, speed=1.4,
-                          legs=(Leg(at=2.0, speed=1.4, turn_deg=-90.0),),
-                          behaviour=Behaviour(model="human", lateral_wander=0.0, sway=0.0,
-                                              surge=0.0))  # fmt: skip
+    walker = HumanWalker(lateral_wander=0.0, sway=0.0, surge=0.0)
+    turn = (Leg(at=2.0, speed=1.4, turn_deg=-90.0),)
+    spec = PedestrianSpec(x=0.0, y=-4.0, heading_deg=90.0, speed=1.4, legs=turn, behaviour=walker)
     track = pedestrian_path(spec, 6.0, seed=0)
     times = np.arange(0.0, 5.0, 0.05)
     yaws = np.unwrap([track.state(float(t)).yaw for t in times])
@@ -163,6 +170,10 @@ def test_the_time_to_contact_of_a_human_walker_agrees_with_a_brute_force_search(
         ('model = "rail"\nstart_time = 1.0', "pedestrian.behaviour.start_time = 1.0: unknown key"),
         ('model = "rail"\nacceleration_distance = -1', "acceleration_distance = -1: must be >= 0"),
         ('model = "human"\nlateral_wander = 2.0', "lateral_wander = 2.0: must be <= 0.5"),
+        (
+            'model = "human"\nacceleration_distance = 1.0',
+            "pedestrian.behaviour.acceleration_distance = 1.0: unknown key",
+        ),
     ],
 )
 def test_bad_behaviour_values_are_one_line_naming_file_field_and_value(tmp_path, table, expected):
@@ -185,14 +196,144 @@ def test_every_collision_and_near_miss_family_has_a_human_version():
             assert scenario.pedestrian.behaviour.model == model
 
 
-# -- intent cues (issue 18) ---------------------------------------------------------------
+# -- walker types -------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class StillWalker:
+    """A walker type defined here, as a new module would: it stands where the plan starts,
+    facing `facing_deg`, whatever the plan says."""
+
+    model: ClassVar[str] = "still"
+    facing_deg: float = 0.0
+
+    @property
+    def cues(self) -> bool:
+        return False
+
+    @property
+    def start_distance(self) -> float:
+        return 0.0
+
+    def placed(self, acceleration_distance: float) -> StillWalker:
+        return self
+
+    def track(self, plan, t_end: float, seed: int) -> Track:
+        yaw = [math.radians(self.facing_deg)]
+        return Track(np.zeros(1), np.array([[plan.x, plan.y]]), np.zeros((1, 2)), yaw)
+
+    def identity(self) -> str:
+        return repr(self)
+
+    @classmethod
+    def from_table(cls, t: TomlTable) -> StillWalker:
+        walker = cls(facing_deg=t.number("facing_deg", 0.0, low=-360.0, high=360.0))
+        t.done()
+        return walker
+
+
+def with_behaviour(tmp_path: Path, table: str) -> Path:
+    """cpna25 (a crossing, anchored at its impact point) with this [pedestrian.behaviour]."""
+    text = (SCENARIOS / "families/small/cpna25.toml").read_text()
+    path = tmp_path / "walker.toml"
+    path.write_text(text.replace("[path]", f"[pedestrian.behaviour]\n{table}\n\n[path]", 1))
+    return path
+
+
+def test_a_registered_walker_type_is_chosen_by_model_and_walked_without_editing_the_path(
+    tmp_path, monkeypatch
+):
+    monkeypatch.setitem(WALKERS, StillWalker.model, StillWalker)  # undone after the test
+    assert isinstance(StillWalker(), Walker)
+    f = load(with_behaviour(tmp_path, 'model = "still"\nfacing_deg = 45'))
+    spec = f.base.pedestrian
+    assert spec.behaviour == StillWalker(facing_deg=45.0)
+    track = pedestrian_path(spec, 6.0, seed=0)
+    anchor = spec.anchor
+    assert anchor is not None
+    # It stands, facing its own way, and is shifted to meet the placement's anchor.
+    for t in (0.0, 2.0, anchor.time, 5.0):
+        state = track.state(t)
+        assert state.speed == 0.0 and state.yaw == pytest.approx(math.radians(45.0))
+        assert state.position == pytest.approx([anchor.x, anchor.y])
+    # Sweep keys pick it and set its keys as they do the others'; its identity is its repr.
+    sweep = {"pedestrian.behaviour.model": "still", "pedestrian.behaviour.facing_deg": 90}
+    swept = load(SCENARIOS / "families/small/cpna25.toml").scenario(sweep, "t", 0)
+    assert swept.pedestrian.behaviour == StillWalker(facing_deg=90.0)
+    assert "StillWalker(facing_deg=90.0)" in scenario_text(swept)
+    with pytest.raises(UserError, match="must be one of rail, human, still"):
+        load(with_behaviour(tmp_path, 'model = "crowd"'))
+
+
+def test_the_registry_is_back_without_the_walker_a_test_added():
+    assert list(WALKERS) == ["rail", "human"]
+
+
+def keys_read(walker: type) -> set[str]:
+    """The keys of [pedestrian.behaviour] a walker type reads (its own, besides model)."""
+    table = TomlTable(Path("w.toml"), "pedestrian.behaviour", {})
+    walker.from_table(table)
+    return table.seen
+
+
+def test_the_rail_and_the_human_walker_share_nothing_but_the_interface():
+    rail, human = keys_read(RailWalker), keys_read(HumanWalker)
+    assert rail == {"acceleration_distance"} and len(human) == 15 and not rail & human
+    assert not {f.name for f in fields(RailWalker)} & {f.name for f in fields(HumanWalker)}
+    assert isinstance(RailWalker(), Walker) and isinstance(HumanWalker(), Walker)
+    assert (RailWalker().cues, HumanWalker().cues) == (False, True)
+
+
+@pytest.mark.parametrize(("model", "other"), [(RailWalker, HumanWalker), (HumanWalker, RailWalker)])
+def test_each_walker_refuses_every_key_of_the_other_in_one_line(model, other):
+    for key in sorted(keys_read(other)):
+        value = getattr(other(), key)
+        value = 1.0 if value is None else value
+        table = TomlTable(
+            Path("w.toml"), "pedestrian.behaviour", {"model": model.model, key: value}
+        )
+        with pytest.raises(FieldError) as err:
+            walker_from_table(table)
+        message = str(err.value)
+        assert message.startswith(f"w.toml: pedestrian.behaviour.{key} = {value!r}: unknown key")
+        assert "\n" not in message
+
+
+def test_run_ids_digest_the_walker_as_the_one_record_of_earlier_versions_did():
+    """The identity text keeps each run's id and seed: digests made before the walker types."""
+    cases = [
+        ("families/small/cpna25.toml", {}, "30a0e2ac"),
+        ("families/small/cpna25.toml", {"pedestrian.behaviour.model": "human"}, "b6005a95"),
+        ("families/small/cpfa50.toml", {"pedestrian.behaviour.model": "human"}, "58ebbd07"),
+        ("cases/case5_perpendicular_right.toml", {"pedestrian.behaviour.model": "human"},
+         "fa5e6eef"),
+        ("families/car/cpla25.toml", {"pedestrian.behaviour.acceleration_distance": 0.7},
+         "33a3d9de"),
+        ("families/small/nearmiss_kerb_stop.toml",
+         {"pedestrian.behaviour.model": "human", "pedestrian.behaviour.head_check_probability": 1.0,
+          "pedestrian.behaviour.stop_lead": 0.0, "pedestrian.behaviour.turn_lead": 0.7},
+         "d2d1adb3"),
+    ]  # fmt: skip
+    for file, extra, digest in cases:
+        f = load(SCENARIOS / file)
+        assert run_scenario(f, {**next(f.runs()), **extra})[2] == digest, (file, extra)
+    # A human walker placed on a crossing writes the side's acceleration distance, as then.
+    human = load(SCENARIOS / "families/small/cpfa50.toml").scenario(
+        {"pedestrian.behaviour.model": "human"}, "t"
+    )
+    assert "Behaviour(model='human', acceleration_distance=1.5, start_time=1.8" in scenario_text(
+        human
+    )
+
+
+# -- intent cues ---------------------------------------------------------------
 
 NO_CUES = {"head_check_probability": 0.0, "turn_lead": 0.0, "stop_lead": 0.0}
 
 
 def crossing_spec(**behaviour: float) -> PedestrianSpec:
     return PedestrianSpec(x=4.0, y=-4.0, heading_deg=90.0, speed=1.4, start_delay=2.0,
-                          behaviour=Behaviour(model="human", **behaviour))  # fmt: skip
+                          behaviour=HumanWalker(**behaviour))  # fmt: skip
 
 
 def test_cues_off_reproduce_the_cue_free_walker_exactly():
@@ -215,8 +356,8 @@ def test_a_head_check_looks_toward_the_traffic_before_stepping_off_and_at_a_stop
     assert max(turned) == pytest.approx(math.radians(60.0), abs=math.radians(1.0))
     stop = PedestrianSpec(x=4.0, y=-4.0, heading_deg=90.0, speed=1.4, start_delay=1.0,
                           legs=(Leg(at=3.0, speed=0.0),),
-                          behaviour=Behaviour(model="human", head_check_probability=1.0,
-                                              head_check_interval=0.0))  # fmt: skip
+                          behaviour=HumanWalker(head_check_probability=1.0,
+                                                head_check_interval=0.0))  # fmt: skip
     track = pedestrian_path(stop, 8.0, 7)
     t, v = speeds(track, 0.0, 8.0, dt=0.05)
     arrived = t[np.flatnonzero(v > 0.05)[-1]]
@@ -225,9 +366,7 @@ def test_a_head_check_looks_toward_the_traffic_before_stepping_off_and_at_a_stop
 
 
 def test_the_head_then_the_shoulders_lead_a_turn():
-    quiet = Behaviour(
-        model="human", head_check_probability=0.0, turn_lead=0.5, lateral_wander=0.0, sway=0.0
-    )
+    quiet = HumanWalker(head_check_probability=0.0, turn_lead=0.5, lateral_wander=0.0, sway=0.0)
     turn = (Leg(at=2.0, speed=1.4, turn_deg=90.0),)
     spec = PedestrianSpec(x=0.0, y=-4.0, heading_deg=0.0, speed=1.4, legs=turn, behaviour=quiet)
     track = pedestrian_path(spec, 6.0, 0)

@@ -19,7 +19,7 @@ from monopic.features.orientation import facing_angle
 from sim.geometry.frames import Pose2D, wrap_angle
 from sim.geometry.highway_frame import highway_to_world, reflect, world_to_highway
 from sim.scenario.cases import CasePlacement, case_heading_deg, default_crossing
-from sim.scenario.path import rail_track
+from sim.scenario.plan import rail_track
 from sim.scenario.spec import (
     CameraSpec,
     Leg,

@@ -1,4 +1,4 @@
-"""The `human` walker: the plan (sim.scenario.path) walked as a person walks it.
+"""The `human` walker: the plan (sim.scenario.plan) walked as a person walks it.
 
 The plan's pieces give a route (a polyline from where the person stands, turning where
 the plan turns) and what happens along it: walk at a speed, change speed, stop at a
@@ -20,24 +20,106 @@ and each step is a vertex of the walker's Track. A walker walking at t = 0 set o
 before, so it is at speed; one that stands first sets off at the plan's start, or, when
 the plan has an anchor, when it must to reach the anchor's distance along its approach
 at the anchor's time (later than the plan's instant start would; see sim.scenario.path).
+
+Intent cues (intent_cues) turn its head and shoulders, never its walk.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field, fields, replace
+from typing import ClassVar
 
 import numpy as np
 
 from sim.geometry.frames import wrap_angle
-from sim.scenario.path import H, Track, plan_pieces
-from sim.scenario.spec import Behaviour, PedestrianSpec
+from sim.scenario.plan import Plan, anchored_plan, plan_pieces
 from sim.scenario.stride import step_length
+from sim.scenario.toml_table import TomlTable
+from sim.scenario.track import H, Track
+from sim.scenario.walkers.base import legacy_text
 
 WANDER_PERIODS = (3.0, 12.0)  # s, the speed wander's sinusoids
 WANDER_WAVELENGTHS = (2.5, 9.0)  # m, the line's sinusoids
 PREROLL = 10.0  # s walked before t = 0 by a walker that is walking at t = 0
 GOING = 0.6  # m/s: from here on the stride's surge and sway are full
+
+
+@dataclass(frozen=True)
+class HumanWalker:
+    """A person walking the plan (scenarios/README.md: units, ranges, sources): starts and
+    stops over a couple of steps (raised-cosine speed profiles), turns along arcs at a
+    bounded yaw rate, wanders a little in speed and sideways, and shows intent cues."""
+
+    model: ClassVar[str] = "human"
+    start_time: float = 1.8  # s from standing to walking speed (about three steps)
+    stop_time: float = 1.2  # s from walking speed to standing (about two steps)
+    max_yaw_rate: float = 90.0  # deg/s along a turn
+    speed_wander: float = 0.10  # amplitude of the speed's slow wander, share of its speed
+    lateral_wander: float = 0.15  # m, amplitude of the sideways wander off the plan's line
+    sway: float = 0.02  # m, the body's side-to-side sway once a stride
+    surge: float = 0.12  # the body's speed rising and falling twice a stride, share of it
+    # Intent cues (probability 0 and lead times 0: a walker without them, exactly):
+    head_check_probability: float = 0.8  # of each head check toward the traffic
+    head_check_lead: float = 1.0  # s before setting off that the check before it begins
+    head_check_duration: float = 0.8  # s, out and back
+    head_check_amplitude: float = 60.0  # deg of head yaw (the shoulders turn torso_share of it)
+    head_check_interval: float = 1.5  # s between checks while walking or standing
+    torso_share: float = 0.3  # of a head turn the shoulders follow
+    turn_lead: float = 0.4  # s the head leads the walking line in turns (shoulders half of it)
+    stop_lead: float = 0.6  # s of slowing to STOP_APPROACH of the speed before braking to a stop
+    # Not a parameter of the walk: the acceleration distance of the placement that put it
+    # (placed), written in its identity text only, as the one record of earlier versions
+    # held it, so that their run ids and seeds stay the same (walkers.base.LEGACY_FIELDS).
+    identity_acceleration_distance: float | None = field(default=None, repr=False, compare=False)
+
+    @property
+    def cues(self) -> bool:
+        return self.head_check_probability > 0 or self.turn_lead > 0 or self.stop_lead > 0
+
+    @property
+    def start_distance(self) -> float:
+        return 0.0  # it sets off when it must to meet the anchor (set_off_time)
+
+    def placed(self, acceleration_distance: float) -> HumanWalker:
+        if self.identity_acceleration_distance is not None:
+            return self
+        return replace(self, identity_acceleration_distance=acceleration_distance)
+
+    def track(self, plan: Plan, t_end: float, seed: int) -> Track:
+        t_start = set_off_time(self, anchored_plan(plan, self.start_distance), seed)
+        return human_track(self, plan, t_end, seed, t_start)
+
+    def identity(self) -> str:
+        values = {f.name: getattr(self, f.name) for f in fields(self) if f.repr}
+        return legacy_text(self.model, self.identity_acceleration_distance, values)
+
+    @classmethod
+    def from_table(cls, t: TomlTable) -> HumanWalker:
+        base = cls()
+
+        def number(key: str, low: float, high: float, unit: str = "") -> float:
+            return t.number(key, getattr(base, key), low=low, high=high, unit=unit)
+
+        walker = cls(
+            start_time=number("start_time", 0.2, 5.0, "s"),
+            stop_time=number("stop_time", 0.2, 5.0, "s"),
+            max_yaw_rate=number("max_yaw_rate", 10.0, 360.0, "deg/s"),
+            speed_wander=number("speed_wander", 0.0, 0.3),
+            lateral_wander=number("lateral_wander", 0.0, 0.5, "m"),
+            sway=number("sway", 0.0, 0.1, "m"),
+            surge=number("surge", 0.0, 0.3),
+            head_check_probability=number("head_check_probability", 0.0, 1.0),
+            head_check_lead=number("head_check_lead", 0.0, 5.0, "s"),
+            head_check_duration=number("head_check_duration", 0.2, 5.0, "s"),
+            head_check_amplitude=number("head_check_amplitude", 0.0, 120.0, "deg"),
+            head_check_interval=number("head_check_interval", 0.0, 30.0, "s"),
+            torso_share=number("torso_share", 0.0, 1.0),
+            turn_lead=number("turn_lead", 0.0, 2.0, "s"),
+            stop_lead=number("stop_lead", 0.0, 3.0, "s"),
+        )
+        t.done()
+        return walker
 
 
 @dataclass(frozen=True)
@@ -50,11 +132,11 @@ class Stretch:
     heading: float
 
 
-def stretches(spec: PedestrianSpec) -> list[Stretch]:
+def stretches(plan: Plan) -> list[Stretch]:
     """The plan's pieces placed along the route by arc length (0 where it sets off)."""
     out: list[Stretch] = []
     s = 0.0
-    pieces = plan_pieces(spec)
+    pieces = plan_pieces(plan)
     for i, (t0, v, heading) in enumerate(pieces):
         out.append(Stretch(s, t0, v, heading))
         if i + 1 < len(pieces):
@@ -104,7 +186,7 @@ class Route:
         return p + (s - done) * _unit(heading), heading
 
 
-def route(spec: PedestrianSpec, plan: list[Stretch], max_yaw_rate: float) -> Route:
+def route(spec: Plan, plan: list[Stretch], max_yaw_rate: float) -> Route:
     """The route through the plan's turns, each corner an arc at the yaw-rate bound."""
     vertices: list[tuple[float, float, float]] = []  # (s, heading after, speed around)
     for p in plan:
@@ -154,7 +236,7 @@ class Walk:
     """The walker's distance along the route over time, H seconds at a time."""
 
     plan: list[Stretch]
-    b: Behaviour
+    b: HumanWalker
     speed_wander: np.ndarray  # _wander table, over time since setting off
 
     def profile(self, t_start: float, s_start: float, t_end: float, until_s: float = math.inf):
@@ -234,9 +316,8 @@ class Walk:
         return np.array(times), np.array(arcs), events
 
 
-def set_off_time(spec: PedestrianSpec, seed: int) -> float:
+def set_off_time(b: HumanWalker, spec: Plan, seed: int) -> float:
     """When the walker sets off: the plan's start, or what meets the plan's anchor."""
-    b = spec.behaviour
     plan = stretches(spec)
     first = next((p for p in plan if p.speed > 0), None)
     if first is None:
@@ -258,9 +339,8 @@ def _tables(seed: int) -> tuple[np.ndarray, np.ndarray]:
     return _wander(rng, WANDER_PERIODS), _wander(rng, WANDER_WAVELENGTHS)
 
 
-def human_track(spec: PedestrianSpec, t_end: float, seed: int, t_start: float) -> Track:
+def human_track(b: HumanWalker, spec: Plan, t_end: float, seed: int, t_start: float) -> Track:
     """The walker's Track from 0 to at least t_end, setting off at `t_start`."""
-    b = spec.behaviour
     for name in ("start_time", "stop_time", "max_yaw_rate"):
         if not getattr(b, name) > 0:
             raise ValueError(f"behaviour.{name} must be > 0, got {getattr(b, name)}")
@@ -342,7 +422,7 @@ def _bump(u: np.ndarray) -> np.ndarray:
 
 
 def intent_cues(
-    b: Behaviour,
+    b: HumanWalker,
     times: np.ndarray,
     path_yaws: np.ndarray,
     speeds: np.ndarray,
