@@ -10,7 +10,7 @@ The robot starts at the origin heading east along the road's lane.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field, fields, replace
 
 from monopic.camera import CameraModel
 from monopic.cases import Case
@@ -195,6 +195,7 @@ class PedestrianSpec:
     # Where a placement says the walker is at a time (its plan passes there then); the
     # walker is shifted to pass it exactly whatever its behaviour. None: no constraint.
     anchor: Anchor | None = None
+    name: str = ""  # the person's name in the scenario ("": the scripted person, "ped")
 
     def heading_at(self, t: float) -> float:
         """Heading in radians at time t (turns of the legs started so far)."""
@@ -223,16 +224,36 @@ class Scenario:
     dt: float = 1.0 / presets.FPS  # s per frame
     horizon: float = presets.HORIZON_S  # s, the warning horizon
     seed: int = 0
+    # The other people in the street. `pedestrian` is the scripted one: in a collision
+    # family the person whose path meets the robot; the warnings are judged against them.
+    bystanders: tuple[PedestrianSpec, ...] = ()
 
     def __post_init__(self) -> None:
         for name in ("duration", "dt", "horizon"):
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"scenario {self.name!r}: {name} must be positive, got {value}")
+        names = [person_name(p, k) for k, p in enumerate(self.people)]
+        if len(set(names)) != len(names):
+            raise ValueError(f"scenario {self.name!r}: two people share a name in {names}")
 
     @property
     def frames(self) -> int:
         return int(round(self.duration / self.dt))
+
+    @property
+    def people(self) -> tuple[PedestrianSpec, ...]:
+        """Everyone in the street, the scripted person first."""
+        return (self.pedestrian, *self.bystanders)
+
+
+SCRIPTED = "ped"  # the scripted person's name when the scenario gives none
+
+
+def person_name(person: PedestrianSpec, index: int) -> str:
+    """A person's name: the scenario's, else "ped" for the scripted person (index 0) and
+    "ped{index}" for the others."""
+    return person.name or (SCRIPTED if index == 0 else f"{SCRIPTED}{index}")
 
 
 def scenario_text(s: Scenario) -> str:
@@ -240,9 +261,23 @@ def scenario_text(s: Scenario) -> str:
     and closed-loop run ids. Its repr, the walker written as its identity (Walker.identity)
     and the scene as its own (scene_identity): any change of the scenario is another run,
     and a new layout of the records is not."""
-    walker = _Written(s.pedestrian.behaviour.identity())
-    scene = _Written(scene_identity(s.scene))
-    return repr(replace(s, pedestrian=replace(s.pedestrian, behaviour=walker), scene=scene))
+    written: dict[str, object] = {
+        "pedestrian": _Written(person_identity(s.pedestrian)),
+        "bystanders": tuple(_Written(person_identity(p)) for p in s.bystanders),
+        "scene": _Written(scene_identity(s.scene)),
+    }
+    parts = [f"{f.name}={written.get(f.name, getattr(s, f.name))!r}" for f in fields(s)
+             if not (f.name == "bystanders" and not s.bystanders)]  # fmt: skip
+    # (A field added since identities were first written shows only when it is set, so a
+    # scenario that does not use it keeps its identity.)
+    return f"Scenario({', '.join(parts)})"
+
+
+def person_identity(person: PedestrianSpec) -> str:
+    """A person as identities have always written them: the walker as its identity, the
+    name (added since) only when it is set."""
+    text = repr(replace(person, behaviour=_Written(person.behaviour.identity())))
+    return text.removesuffix(", name='')") + ")" if not person.name else text
 
 
 def scene_identity(scene: SceneSpec) -> str:

@@ -85,6 +85,81 @@ class RobotState:
         }
 
 
+# What hides part of a body from the camera, by the kind of body that owns the geom the
+# line of sight meets first (Entity.kind); "scene": the street, its buildings, any other.
+HIDERS = ("person", "parked car", "scene")
+SIGHT_SAMPLES = 12  # points a body geom contributes to the visibility estimate
+
+
+@dataclass(frozen=True)
+class Visibility:
+    """How much of a body's surface the camera sees, from points sampled on it (its share
+    hidden by each kind of body, and outside the image), and the box of what it sees.
+
+    Shares are of the sampled points (SIGHT_SAMPLES on each geom of the body, evenly over
+    directions), so a small far body is judged as finely as a near one; they sum to 1 with
+    `visible`. A point behind the body's own front is not counted as hidden: the body
+    hiding itself is what every view of a person does, not occlusion."""
+
+    visible: float
+    hidden_by: dict[str, float]  # HIDERS -> share
+    outside_frame: float
+    box: tuple[float, float, float, float]  # px (u0, v0, u1, v1) of the visible points; NaN
+
+    @property
+    def hidden(self) -> float:
+        return float(sum(self.hidden_by.values()))
+
+    def to_dict(self) -> dict[str, object]:
+        return {
+            "visible": self.visible,
+            "hidden_by": dict(self.hidden_by),
+            "outside_frame": self.outside_frame,
+            "box": _plain(np.array(self.box)),
+        }
+
+
+def visibility(
+    model: mujoco.MjModel,
+    data: mujoco.MjData,
+    camera: CameraModel,
+    robot: Pose2D,
+    camera_world: np.ndarray,
+    points_world: np.ndarray,
+    own_geoms: np.ndarray,
+    geom_kind: np.ndarray,
+) -> Visibility:
+    """The Visibility of a body whose surface points are `points_world` (N, 3).
+
+    One MuJoCo ray per point from the camera (mj_multiRay over the geoms the camera
+    draws); the first geom hit decides: another body's (by its kind, `geom_kind[geom]`
+    an index into HIDERS), or the body's own or nothing (seen, if inside the image)."""
+    px = camera.project(robot.to_local(points_world))
+    with np.errstate(invalid="ignore"):
+        inside = in_image(camera, px)
+    rays = np.asarray(points_world, dtype=float) - camera_world
+    dist = np.linalg.norm(rays, axis=1)
+    n = len(rays)
+    hit_geom = np.full(n, -1, dtype=np.int32)
+    hit_dist = np.full(n, -1.0)
+    if n:
+        unit = (rays / np.maximum(dist, 1e-9)[:, None]).reshape(-1)
+        mujoco.mj_multiRay(
+            model, data, np.asarray(camera_world, dtype=float), unit, VISIBLE_GEOM_GROUPS, 1,
+            -1, hit_geom, hit_dist, None, n, float(dist.max()) + 1.0,
+        )  # fmt: skip
+    blocked = (hit_dist >= 0) & (hit_dist < dist - OCCLUSION_TOLERANCE)
+    blocked &= ~np.isin(hit_geom, own_geoms)
+    kinds = np.where(blocked, geom_kind[np.clip(hit_geom, 0, None)], -1)
+    shares = {name: float(np.mean(inside & (kinds == k))) for k, name in enumerate(HIDERS)}
+    seen = inside & ~blocked
+    box = (math.nan,) * 4
+    if seen.any():
+        (u0, v0), (u1, v1) = px[seen].min(axis=0), px[seen].max(axis=0)
+        box = (float(u0), float(v0), float(u1), float(v1))
+    return Visibility(float(seen.mean()), shares, float(1.0 - inside.mean()), box)
+
+
 @dataclass(frozen=True)
 class PersonTruth:
     """Everything true about one pedestrian at one frame (PedestrianBody.truth)."""
@@ -127,6 +202,10 @@ class PersonTruth:
     # Where the head looks (from the posed mannequin: nose ahead of the ears' midpoint).
     head_yaw_shoulders: float = 0.0  # rad, head turned from the shoulders' facing (+ left)
     head_yaw_camera: float = math.nan  # rad, head facing from the line to the camera (0: at it)
+    # The square the person occupies on the ground: corners (4, 2), world frame.
+    footprint_world: np.ndarray = field(default_factory=lambda: np.full((4, 2), np.nan))
+    # How much of the body the camera sees (sim.world.ground_truth.Visibility).
+    visibility: Visibility | None = None
 
     @property
     def landmarks_px(self) -> np.ndarray:
@@ -149,9 +228,18 @@ class PersonTruth:
         """True apparent height of the whole body in pixels (ignoring occlusion)."""
         return self.body.box_height
 
-    def to_dict(self) -> dict[str, object]:
-        """Plain JSON-ready values (NaN as None)."""
+    def to_dict(self, full: bool = False) -> dict[str, object]:
+        """Plain JSON-ready values (NaN as None); `full` adds the name, the footprint and
+        the visibility (what a person among several is told by)."""
+        extra: dict[str, object] = {}
+        if full:
+            extra = {
+                "name": self.name,
+                "footprint_world": _plain(self.footprint_world),
+                "visibility": None if self.visibility is None else self.visibility.to_dict(),
+            }
         return {
+            **extra,
             "position_world": _plain(self.position_world),
             "velocity_world": _plain(self.velocity_world),
             "heading_world": self.heading_world,
@@ -207,14 +295,18 @@ class GroundTruth:
         return self.people[0]
 
     def to_dict(self) -> dict[str, object]:
-        """Plain JSON-ready values (NaN as None), e.g. for gym infos and result lines:
-        the robot and the scenario's pedestrian."""
-        return {
+        """Plain JSON-ready values (NaN as None), e.g. for gym infos and dataset lines: the
+        robot and the scripted pedestrian at the top level (as with one person), and with
+        several people `people`, each person's in the scene's order."""
+        out = {
             "time": self.time,
             "index": self.index,
             "robot": self.robot.to_dict(),
             **self.pedestrian.to_dict(),
         }
+        if len(self.people) > 1:
+            out["people"] = [p.to_dict(full=True) for p in self.people]
+        return out
 
 
 def _plain(values: np.ndarray) -> object:

@@ -28,6 +28,7 @@ from sim.world.entities.base import Entity, Moment
 from sim.world.entities.parked_car import ParkedCar
 from sim.world.entities.pedestrian import PedestrianBody
 from sim.world.entities.robot import RobotBody
+from sim.world.ground_truth import HIDERS
 from sim.world.lighting import build_sky, lights
 from sim.world.street import build_street
 
@@ -167,6 +168,15 @@ class Scene:
         """Recompute body, camera and light poses after bodies were placed."""
         mujoco.mj_kinematics(self.model, self.data)
         mujoco.mj_camlight(self.model, self.data)
+
+    def geom_kinds(self) -> np.ndarray:
+        """Per geom: the kind of body that owns it, an index into ground_truth.HIDERS
+        (people, parked cars; the street and anything else the last)."""
+        kinds = np.full(self.model.ngeom, len(HIDERS) - 1, dtype=int)
+        for entity in self.entities:
+            if entity.kind in HIDERS:
+                kinds[entity.geom_ids(self.model)] = HIDERS.index(entity.kind)
+        return kinds
 
     def geoms_of(self, entity: Entity) -> np.ndarray:
         """The geom ids of one body (for a segmentation mask, an occlusion test)."""

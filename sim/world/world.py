@@ -32,7 +32,7 @@ from highway_env.road.road import Road
 from monopic.camera import CameraModel
 from monopic.closing import Closing
 from monopic.frame import EgoState, Frame
-from sim.scenario.spec import Scenario
+from sim.scenario.spec import Scenario, person_name
 from sim.world.entities.base import Entity, Moment, Sight
 from sim.world.entities.pedestrian import PedestrianBody
 from sim.world.entities.robot import RobotBody
@@ -62,12 +62,17 @@ class WorldStep:
 
 def scenario_entities(scenario: Scenario, t_end: float) -> list[Entity]:
     """The bodies of a scenario's world, in the order the scene builds them: its parked
-    cars, its lights, the robot and its pedestrian (walking `t_end` seconds ahead)."""
+    cars, its lights, the robot and its people, the scripted one first (each walking
+    `t_end` seconds ahead)."""
+    people = [
+        PedestrianBody(p.looks, p, name=person_name(p, k), t_end=t_end)
+        for k, p in enumerate(scenario.people)
+    ]
     return [
         *parked_cars(scenario.scene),
         *lights(scenario.scene.lighting),
         RobotBody(scenario.robot.camera.model(), scenario.robot),
-        PedestrianBody(scenario.pedestrian.looks, scenario.pedestrian, t_end=t_end),
+        *people,
     ]
 
 
@@ -94,6 +99,7 @@ class World(Closing):
         t_end = scenario.duration + ttc_lookahead + CASE_WINDOW + 1.0
         entities = [*scenario_entities(scenario, t_end), *extra]
         self.scene = Scene(SceneConfig.of(scenario), entities)
+        self._geom_kinds = self.scene.geom_kinds()
         self.camera: CameraModel = self.scene.camera
         self._renderer: SceneRenderer | None = None
         self.road: Road | None = None
@@ -221,6 +227,7 @@ class World(Closing):
             robot_velocity=body.vehicle.velocity,
             horizon=self.scenario.horizon,
             lookahead=self.ttc_lookahead,
+            geom_kind=self._geom_kinds,
         )
         people: list[PersonTruth] = []
         others: dict[str, object] = {}

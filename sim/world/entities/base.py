@@ -16,7 +16,7 @@ writes a MuJoCo array that belongs to one of them: adding a kind of body is one 
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import mujoco
@@ -52,6 +52,9 @@ class Sight:
     robot_velocity: np.ndarray  # (2,) highway-env frame, m/s
     horizon: float  # s, the warning horizon
     lookahead: float  # s, how far ahead times to collision are searched
+    # Per geom of the scene: the kind of body that owns it (an index into
+    # sim.world.ground_truth.HIDERS), for what hides whom.
+    geom_kind: np.ndarray = field(default_factory=lambda: np.zeros(0, dtype=int))
 
 
 class Entity:
@@ -59,6 +62,7 @@ class Entity:
     static body with no motion and no truth."""
 
     name: str = "entity"  # its MJCF names start with `name + "/"`
+    kind: str = "body"  # what it is to the truth ("person", "parked car": what hides whom)
 
     @property
     def prefix(self) -> str:

@@ -22,6 +22,8 @@ from sim.world.street import add_box, add_material
 class ParkedCar(Entity):
     """One parked car where the scenario puts it (static)."""
 
+    kind = "parked car"
+
     def __init__(self, occluder: Occluder, name: str) -> None:
         self.occluder = occluder
         self.name = name

@@ -17,12 +17,14 @@ from highway_env.road.road import Road
 
 from monopic.camera import CameraModel
 from sim.geometry.frames import Pose2D, wrap_angle
+from sim.geometry.polygons import rectangle
 from sim.scenario.spec import MannequinSpec, PedestrianSpec
 from sim.world.body import PedestrianTruth, make_truth
 from sim.world.entities.base import Entity, Moment, Sight
 from sim.world.gait import Gait, MannequinPose
 from sim.world.ground_truth import (
     CASE_WINDOW,
+    SIGHT_SAMPLES,
     TORSO_LANDMARKS,
     PersonTruth,
     case_label,
@@ -32,15 +34,18 @@ from sim.world.ground_truth import (
     occluded_landmarks,
     polygons_intersect,
     time_to_contact,
+    visibility,
 )
 from sim.world.intent import intent_label
-from sim.world.mannequin import Mannequin, build_mannequin
+from sim.world.mannequin import GeomShapes, Mannequin, build_mannequin
 from sim.world.pedestrian import Pedestrian
 
 
 class PedestrianBody(Entity):
     """One person: `looks` for the mannequin; `walk` (the scenario's pedestrian) and
     `t_end` (how far ahead the walk is worked out) for a run."""
+
+    kind = "person"
 
     def __init__(
         self,
@@ -68,6 +73,8 @@ class PedestrianBody(Entity):
 
     def bind(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
         self.mannequin = Mannequin(model, self.looks, self.prefix)
+        # A coarser sample of the surface than the apparent box's, for what is hidden.
+        self.sight_shapes = GeomShapes.of(model, self.mannequin.geom_ids, n=SIGHT_SAMPLES)
 
     def geom_ids(self, model: mujoco.MjModel) -> np.ndarray:
         return self.mannequin.geom_ids
@@ -197,6 +204,12 @@ class PedestrianBody(Entity):
         shoulders = ped.yaw + ped.torso_yaw
         facing, facing_view, beta, phi = facing_angles(pose, camera, ped.position, shoulders)
         head_from_shoulders, head_from_camera = head_yaws(body.landmarks_world, sight.camera_world)
+        seen = visibility(
+            model, data, camera, pose, sight.camera_world,
+            self.sight_shapes.surface_points(data), self.mannequin.geom_ids, sight.geom_kind,
+        )  # fmt: skip
+        size = self.walk.footprint if self.walk is not None else math.nan
+        footprint = rectangle(ped.position, ped.footprint_yaw, size, size)
         return PersonTruth(
             name=self.name,
             position_world=ped.position.copy(),
@@ -229,6 +242,8 @@ class PedestrianBody(Entity):
             phi=phi,
             head_yaw_shoulders=head_from_shoulders,
             head_yaw_camera=head_from_camera,
+            footprint_world=footprint,
+            visibility=seen,
         )
 
     def mask_geoms(self) -> frozenset[int]:

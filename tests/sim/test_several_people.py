@@ -1,0 +1,76 @@
+"""Several people in the simulated world: each a body, each with their own truth."""
+
+from __future__ import annotations
+
+import pytest
+
+from sim.scenario.spec import (
+    CameraSpec,
+    Occluder,
+    PedestrianSpec,
+    RoadLayout,
+    RobotSpec,
+    Scenario,
+    SceneSpec,
+)
+from sim.world.world import World
+
+ROBOT = RobotSpec(speed=0.0, camera=CameraSpec(320, 180))
+STREET = SceneSpec(road=RoadLayout(buildings=False))
+# The scripted person stands 10 m ahead on the robot's line; a bystander 5 m ahead on the
+# same line stands between them and the camera.
+FAR = PedestrianSpec(x=10.0, y=0.0, heading_deg=90.0, speed=0.0)
+NEAR = PedestrianSpec(x=5.0, y=0.0, heading_deg=90.0, speed=0.0, name="near")
+
+
+def scenario(*bystanders: PedestrianSpec, scene: SceneSpec = STREET) -> Scenario:
+    return Scenario(
+        name="people", pedestrian=FAR, robot=ROBOT, scene=scene, duration=0.2,
+        bystanders=bystanders,
+    )  # fmt: skip
+
+
+def first_truth(sc: Scenario):  # noqa: ANN201 - a GroundTruth
+    with World(sc, render=False) as world:
+        return world.reset().truth
+
+
+def test_each_person_has_a_truth_of_their_own_the_scripted_first() -> None:
+    truth = first_truth(scenario(NEAR))
+    assert [p.name for p in truth.people] == ["ped", "near"]
+    assert truth.pedestrian is truth.people[0]
+    far, near = truth.people
+    assert far.position_robot[0] == pytest.approx(10.0)
+    assert near.position_robot[0] == pytest.approx(5.0)
+    # The nearer person looks taller and their footprint is where they stand.
+    assert near.apparent_height > 1.5 * far.apparent_height
+    assert near.footprint_world.mean(axis=0) == pytest.approx([5.0, 0.0])
+
+
+def test_a_person_in_front_hides_the_one_behind() -> None:
+    alone = first_truth(scenario()).pedestrian.visibility
+    behind = first_truth(scenario(NEAR))
+    far, near = behind.people
+    assert alone is not None and far.visibility is not None and near.visibility is not None
+    assert alone.hidden == 0.0 and alone.visible > 0.9
+    assert far.visibility.hidden_by["person"] > 0.5  # mostly behind the near person
+    assert near.visibility.hidden == 0.0
+    # The visible part's box lies inside the whole body's.
+    u0, v0, u1, v1 = far.visibility.box
+    bu0, bv0, bu1, bv1 = far.box
+    assert bu0 - 1 <= u0 and u1 <= bu1 + 1 and bv0 - 1 <= v0 and v1 <= bv1 + 1
+
+
+def test_a_parked_car_hides_by_its_kind_and_the_frame_edge_counts_apart() -> None:
+    car = SceneSpec(road=RoadLayout(buildings=False), occluders=(Occluder.parked_car(6.0, 0.0),))
+    seen = first_truth(scenario(scene=car)).pedestrian.visibility
+    assert seen is not None
+    assert seen.hidden_by["parked car"] > 0.2 and seen.hidden_by["person"] == 0.0
+    aside = PedestrianSpec(x=2.0, y=2.5, heading_deg=0.0, speed=0.0, name="aside")
+    edge = first_truth(scenario(aside)).people[1].visibility
+    assert edge is not None and edge.outside_frame > 0.2
+
+
+def test_two_people_with_one_name_are_refused() -> None:
+    with pytest.raises(ValueError, match="share a name"):
+        scenario(NEAR, NEAR)
