@@ -14,7 +14,7 @@ import numpy as np
 
 from monopic.pipeline import FrameResult
 from sim.runs.loop import Listener, LoopFrame
-from sim.runs.result import DecisionColumns, PipelineColumns, TruthColumns
+from sim.runs.result import DecisionColumns, PersonColumns, PipelineColumns, TruthColumns
 from sim.world.ground_truth import GroundTruth
 
 STAGES = ("pose", "detect", "landmarks", "features", "predict", "warning", "total")
@@ -37,12 +37,40 @@ def rounded_point(values: Any, digits: int) -> list[float | None] | None:
 
 @dataclass
 class TruthRecorder(Listener):
-    """The truth's columns, frame by frame."""
+    """The truth's columns, frame by frame: the scripted person's, and with several people
+    every person's and who was first on a collision course."""
 
     columns: TruthColumns = field(default_factory=TruthColumns)
+    people: list[PersonColumns] = field(default_factory=list)
+    first_threat: str | None = None
 
     def frame(self, frame: LoopFrame) -> None:
         self.add(frame.truth)
+        if len(frame.truth.people) > 1:
+            self.add_people(frame.truth)
+
+    def add_people(self, truth: GroundTruth) -> None:
+        if not self.people:
+            self.people = [PersonColumns(p.name, k == 0) for k, p in enumerate(truth.people)]
+        for c, p in zip(self.people, truth.people, strict=True):
+            c.collision.append(int(p.collision))
+            c.contact.append(int(p.contact))
+            c.ttc.append(rounded(p.time_to_collision, 3))
+            c.case.append(int(p.case))
+            c.forward.append(rounded(p.position_robot[0], 2))
+            c.lateral.append(rounded(p.position_robot[1], 2))
+            c.in_frame.append(int(p.in_frame))
+            c.box.append(rounded_point(p.box, 1))
+            seen = p.visibility
+            c.visible_box.append(None if seen is None else rounded_point(seen.box, 1))
+            c.visible.append(None if seen is None else rounded(seen.visible, 3))
+            hidden = {} if seen is None else seen.hidden_by
+            c.hidden_by_people.append(rounded(hidden.get("person"), 3))
+            c.hidden_by_cars.append(rounded(hidden.get("parked car"), 3))
+            c.hidden_by_scene.append(rounded(hidden.get("scene"), 3))
+            c.outside_frame.append(None if seen is None else rounded(seen.outside_frame, 3))
+        if self.first_threat is None:  # the first frame anyone is on course; scripted first
+            self.first_threat = next((p.name for p in truth.people if p.collision), None)
 
     def add(self, truth: GroundTruth) -> None:
         c, p = self.columns, truth.pedestrian  # the scenario's pedestrian

@@ -5,13 +5,20 @@ line); metrics, the report and the ground replay read them back as records, so a
 is named in one place. Per-frame quantities are columns (one list entry per processed
 frame, None where there is nothing to say), rounded where they are written (RunColumns).
 
-Growing it:
+Growing it (one rule for every growth: the lighting, several people, the camera):
 - A new field gets a default (None, an empty list, a default_factory) and is appended to
   its record; lines written before it load with the default, so SCHEMA stays. Reading
   code must accept the default (e.g. a behaviour model's head yaw: a column that is None
-  on lines of walkers without one).
-- Several pedestrians: `truth` and each pipeline's columns stay the primary pedestrian's;
-  the others go in a new list field of per-pedestrian truth records (default empty).
+  on lines of walkers without one). Where the default cannot say what an old line's run
+  had, a function named `_<field>_of_old_lines` says it once (the walker model, the
+  lighting preset).
+- A field that describes what only some runs have (several people) is written only on
+  their lines (OPTIONAL, after ORDER's keys): a run without it writes the line it always
+  wrote, and reads back with the default.
+- Several pedestrians: `truth` and each pipeline's columns stay the scripted person's (the
+  one the warnings are judged against); with several people `people` holds every
+  person's truth columns (the scripted one first) and `first_threat` names the person
+  first on a collision course.
 - SCHEMA goes up when a field is renamed, removed or changes meaning or units: lines of
   another schema are then refused with one line saying how to redo them, never read as
   if they meant the new thing.
@@ -67,6 +74,29 @@ class TruthColumns:
     # case of the velocity now (the current-velocity baseline). Empty on lines before them.
     intent: list[str | None] = field(default_factory=list)
     case_now: list[int | None] = field(default_factory=list)
+
+
+@dataclass
+class PersonColumns:
+    """One person's truth per frame, in a run with several people (TruthColumns holds the
+    scripted person's in full; these are what judging every person needs)."""
+
+    name: str
+    scripted: bool = False  # the person the run's warnings are judged against
+    collision: list[int] = field(default_factory=list)  # 1: contact within the horizon
+    contact: list[int] = field(default_factory=list)
+    ttc: list[float | None] = field(default_factory=list)  # s to contact
+    case: list[int] = field(default_factory=list)
+    forward: list[float | None] = field(default_factory=list)  # m, robot frame
+    lateral: list[float | None] = field(default_factory=list)  # m, robot frame (left +)
+    in_frame: list[int] = field(default_factory=list)
+    box: list[list[float | None] | None] = field(default_factory=list)  # px, whole body
+    visible_box: list[list[float | None] | None] = field(default_factory=list)  # px, seen part
+    visible: list[float | None] = field(default_factory=list)  # share of the body seen
+    hidden_by_people: list[float | None] = field(default_factory=list)
+    hidden_by_cars: list[float | None] = field(default_factory=list)
+    hidden_by_scene: list[float | None] = field(default_factory=list)
+    outside_frame: list[float | None] = field(default_factory=list)
 
 
 @dataclass
@@ -159,10 +189,14 @@ class RunResult:
     seed: int = 0
     code: str | None = None  # sim.runs.code_version of the code that ran it
     frames: int = 0
-    contact_time: float | None = None
+    contact_time: float | None = None  # when the scripted person is first in contact
     recording: str | None = None  # the kept .rrd, relative to the recordings folder
     pipelines: dict[str, PipelineColumns] = field(default_factory=dict)  # "main", "gtcrop"
     timing: Timing = field(default_factory=Timing)
+    # Runs with several people only (OPTIONAL): every person's truth, and who was first
+    # on a collision course (None: nobody).
+    people: list[PersonColumns] = field(default_factory=list)
+    first_threat: str | None = None
 
     # JSON key order of a line (the fields above in the order lines have always had).
     ORDER = (
@@ -170,10 +204,16 @@ class RunResult:
         "scenario", "frames", "contact_time", "recording", "truth", "pipelines", "timing",
     )  # fmt: skip
 
+    # Keys written only on the lines of runs that have them (see "Growing it").
+    OPTIONAL = ("people", "first_threat")
+
     def to_json(self) -> dict[str, Any]:
         """The line as JSON-ready data (plain dicts and lists)."""
         plain = to_plain(self)
-        return {k: plain[k] for k in self.ORDER}
+        line = {k: plain[k] for k in self.ORDER}
+        if self.people:
+            line.update({k: plain[k] for k in self.OPTIONAL})
+        return line
 
     def deterministic(self) -> dict[str, Any]:
         """The line without measured times: equal whichever executor or machine ran it."""

@@ -161,6 +161,8 @@ def run(
         contact_time=end.contact_time,
         recording=recording_path,
         truth=truth.columns,
+        people=truth.people,
+        first_threat=truth.first_threat,
         pipelines={name: r.finished() for name, r in recorders.items()},
         timing=Timing(
             wall_s=round(time.perf_counter() - start, 3),

@@ -2,8 +2,14 @@
 
 from __future__ import annotations
 
+import json
+from dataclasses import replace
+
 import pytest
 
+from sim.runs.result import RunResult
+from sim.runs.run_spec import RunSpec
+from sim.runs.runner import run
 from sim.scenario.spec import (
     CameraSpec,
     Occluder,
@@ -74,3 +80,25 @@ def test_a_parked_car_hides_by_its_kind_and_the_frame_edge_counts_apart() -> Non
 def test_two_people_with_one_name_are_refused() -> None:
     with pytest.raises(ValueError, match="share a name"):
         scenario(NEAR, NEAR)
+
+
+def test_a_run_with_several_people_records_each_and_names_the_first_threat() -> None:
+    """The scripted person stands still ahead; a bystander walks into the robot's path."""
+    walker = PedestrianSpec(x=1.0, y=1.5, heading_deg=-90.0, speed=1.5, name="walker")
+    sc = replace(scenario(walker), robot=replace(ROBOT, speed=1.0), duration=0.6)
+    result = run(RunSpec(id="people/0", scenario=sc, ablation=False, stop_at_contact=False))
+    assert [p.name for p in result.people] == ["ped", "walker"]
+    assert [p.scripted for p in result.people] == [True, False]
+    assert all(len(p.collision) == result.frames for p in result.people)
+    assert result.first_threat == "walker"  # on course within the horizon, the other never
+    assert result.people[1].collision[-1] == 1 and not any(result.people[0].collision)
+    line = result.to_json()
+    assert line["first_threat"] == "walker" and len(line["people"]) == 2
+    assert RunResult.from_json(json.loads(json.dumps(line))).people == result.people
+
+
+def test_a_one_person_line_is_written_as_it_always_was() -> None:
+    result = run(RunSpec(id="one/0", scenario=replace(scenario(), duration=0.2), ablation=False))
+    line = result.to_json()
+    assert result.people == [] and "people" not in line and "first_threat" not in line
+    assert list(line) == list(RunResult.ORDER)
