@@ -74,6 +74,8 @@ HEAD_COLOUR = (120, 120, 255)  # the true head yaw beside the true phi
 ROBOT_COLOUR = (50, 200, 0)
 ZONE_COLOUR = (150, 240, 150)  # the robot's swept zone on the ground
 PEDESTRIAN_COLOUR = (255, 140, 0)
+PERSON_COLOUR = (200, 200, 200)  # a person among several, not on a collision course
+COURSE_COLOUR = (255, 60, 60)  # a person on a collision course within the horizon
 ROAD_COLOUR = (150, 150, 150)
 BRAKE_COLOUR = (255, 110, 70)
 # State lanes (alarm/*): what a predictor said and what was really coming, colour for colour.
@@ -273,6 +275,7 @@ class SimRecording(WholeOrNothing):
         self.run = RunRecording(Path(path), application_id, recording_id or self.scenario.name)
         self._topdown: TopDownCamera | None = None
         self._static_done = False
+        self._people_static = False
         self._robot_trail: list[list[float]] = []
         self._was_found = False
         self._was_colliding = False
@@ -448,6 +451,8 @@ class SimRecording(WholeOrNothing):
         self._log_decisions(result)
         self._log_camera_truth(truth)
         self._log_world(step)
+        if len(truth.people) > 1:
+            self._log_people(truth)
         self._log_series(truth)
         self._log_events(step, result)
         if self.topdown_every and step.index % self.topdown_every == 0 and self.world.road:
@@ -625,6 +630,62 @@ class SimRecording(WholeOrNothing):
                 radii=0.04,
             ),
         )
+
+    def _log_people(self, truth: GroundTruth) -> None:
+        """With several people, each under their own name, the scripted one included: the
+        skeleton and footprint in the world, the whole and the visible box in the camera,
+        red while on a collision course, labelled with how much of them is hidden."""
+        rec = self.rec
+        if not self._people_static:
+            rec.log("world/people", skeleton_context("person", PERSON_COLOUR), static=True)
+            self._people_static = True
+        for p in truth.people:
+            colour = COURSE_COLOUR if p.collision else PERSON_COLOUR
+            rec.log(
+                f"world/people/{p.name}",
+                rr.Points3D(
+                    p.body.landmarks_world,
+                    class_ids=0,
+                    keypoint_ids=np.arange(len(LANDMARK_NAMES)),
+                    radii=0.025,
+                    colors=[colour],
+                ),
+            )
+            ring = np.vstack([p.footprint_world, p.footprint_world[:1]])
+            rec.log(
+                f"world/people/{p.name}/footprint",
+                rr.LineStrips3D(
+                    [np.column_stack([ring, np.full(len(ring), 0.02)])], colors=[colour], radii=0.02
+                ),
+            )
+            seen = p.visibility
+            hidden = 0.0 if seen is None else seen.hidden
+            label = f"{p.name}{' on course' if p.collision else ''}, {hidden:.0%} hidden"
+            if not p.in_frame:
+                rec.log(f"camera/people_truth/{p.name}", rr.Clear(recursive=True))
+                continue
+            rec.log(
+                f"camera/people_truth/{p.name}/box",
+                rr.Boxes2D(
+                    array=np.array(p.box),
+                    array_format=rr.Box2DFormat.XYXY,
+                    colors=[colour],
+                    labels=[label],
+                ),  # fmt: skip
+            )
+            if seen is not None and np.all(np.isfinite(seen.box)):
+                rec.log(
+                    f"camera/people_truth/{p.name}/visible",
+                    rr.Boxes2D(
+                        array=np.array(seen.box),
+                        array_format=rr.Box2DFormat.XYXY,
+                        colors=[colour],
+                        radii=-0.5,
+                    ),  # fmt: skip
+                )
+            else:
+                rec.log(f"camera/people_truth/{p.name}/visible", rr.Clear(recursive=False))
+        rec.log("truth/threats", rr.Scalars(float(sum(p.collision for p in truth.people))))
 
     def _log_series(self, truth: GroundTruth) -> None:
         rec = self.rec

@@ -7,6 +7,7 @@ from dataclasses import replace
 
 import pytest
 
+from sim.runs.record import record_run
 from sim.runs.result import RunResult
 from sim.runs.run_spec import RunSpec
 from sim.runs.runner import run
@@ -20,6 +21,7 @@ from sim.scenario.spec import (
     SceneSpec,
 )
 from sim.world.world import World
+from tests.rrd import column, rows_per_entity
 
 ROBOT = RobotSpec(speed=0.0, camera=CameraSpec(320, 180))
 STREET = SceneSpec(road=RoadLayout(buildings=False))
@@ -102,3 +104,18 @@ def test_a_one_person_line_is_written_as_it_always_was() -> None:
     line = result.to_json()
     assert result.people == [] and "people" not in line and "first_threat" not in line
     assert list(line) == list(RunResult.ORDER)
+
+
+def test_the_recording_shows_each_person_under_their_name(tmp_path) -> None:  # noqa: ANN001
+    rrd = tmp_path / "people.rrd"
+    summary = record_run(replace(scenario(NEAR), duration=0.4), rrd)
+    counts = rows_per_entity(rrd)
+    for name in ("ped", "near"):
+        assert counts[f"/world/people/{name}"] == summary.frames
+        assert counts[f"/world/people/{name}/footprint"] == summary.frames
+        assert counts[f"/camera/people_truth/{name}/box"] == summary.frames
+    labels = column(rrd, "/camera/people_truth/ped/box", "Boxes2D:labels")
+    assert "ped, 97% hidden" in str(labels[0])  # behind the near person
+    alone = tmp_path / "alone.rrd"
+    record_run(replace(scenario(), duration=0.2), alone)
+    assert not any(e.startswith("/world/people") for e in rows_per_entity(alone))
