@@ -7,6 +7,7 @@ from dataclasses import replace
 
 import pytest
 
+from sim.analysis.tracks import sweep_tracks
 from sim.runs.record import record_run
 from sim.runs.result import RunResult
 from sim.runs.run_spec import RunSpec
@@ -119,3 +120,10 @@ def test_the_recording_shows_each_person_under_their_name(tmp_path) -> None:  # 
     alone = tmp_path / "alone.rrd"
     record_run(replace(scenario(), duration=0.2), alone)
     assert not any(e.startswith("/world/people") for e in rows_per_entity(alone))
+
+
+def test_tracks_hold_every_person_named() -> None:
+    spec = RunSpec(id="people/0", scenario=scenario(NEAR))
+    tracks = sweep_tracks([spec])
+    assert [t.person for t in tracks] == ["ped", "near"]
+    assert tracks[1].positions[0] == pytest.approx([5.0, 0.0])
