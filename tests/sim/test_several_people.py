@@ -5,9 +5,12 @@ from __future__ import annotations
 import json
 from dataclasses import replace
 
+import gymnasium as gym
+import numpy as np
 import pytest
 
 from sim.analysis.tracks import sweep_tracks
+from sim.envs import ENV_ID
 from sim.runs.record import record_run
 from sim.runs.result import RunResult
 from sim.runs.run_spec import RunSpec
@@ -127,3 +130,16 @@ def test_tracks_hold_every_person_named() -> None:
     tracks = sweep_tracks([spec])
     assert [t.person for t in tracks] == ["ped", "near"]
     assert tracks[1].positions[0] == pytest.approx([5.0, 0.0])
+
+
+def test_the_gymnasium_info_carries_every_persons_truth() -> None:
+    env = gym.make(ENV_ID, config={"scenario": scenario(NEAR)})
+    try:
+        _, info = env.reset(seed=0)
+        people = info["truth"]["people"]
+        assert [p["name"] for p in people] == ["ped", "near"]
+        assert people[0]["visibility"]["hidden_by"]["person"] > 0.5
+        _, _, _, _, info = env.step(np.zeros(1, dtype=np.float32))
+        assert len(info["truth"]["people"]) == 2
+    finally:
+        env.close()
