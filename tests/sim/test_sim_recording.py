@@ -138,7 +138,7 @@ def test_recording_holds_camera_truth_world_and_series(tmp_path):
     assert phi == pytest.approx([t.pedestrian.phi for t in truth])
     ttc = values(rrd, "/ttc/truth")
     assert ttc == pytest.approx([t.pedestrian.time_to_collision for t in truth])
-    assert ttc[0] == pytest.approx(truth[0].time_to_collision) and 0.5 < ttc[0] < 1.0
+    assert ttc[0] == pytest.approx(truth[0].pedestrian.time_to_collision) and 0.5 < ttc[0] < 1.0
     gap = values(rrd, "/truth/gap")
     assert gap[-1] == 0.0 and gap[0] == pytest.approx(
         footprint_gap(truth[0], scenario.pedestrian.footprint)
@@ -189,7 +189,7 @@ def test_recording_holds_camera_truth_world_and_series(tmp_path):
     world = next(v for v in views.values() if v["origin"] == "world")
     target = np.array(world["EyeControls3D:look_target"])
     eye = np.array(world["EyeControls3D:position"])
-    meet = truth[-1].position_world  # contact: the pedestrian where they met
+    meet = truth[-1].pedestrian.position_world  # contact: the pedestrian where they met
     start = truth[0].robot.position[:2]
     assert np.linalg.norm(target[:2] - (start + (meet - start) * 2 / 3)) < 0.5
     assert target[2] == 0.0 and eye[0] < start[0] and eye[2] > 1.0  # behind the start, above
