@@ -25,9 +25,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "([[include]] of scenario files, as `monopic sweep` reads it: the same runs, ids and "
         "seeds; a grid over the nine cases sweeps path.case of "
         "scenarios/datasets/case_grid.toml); see scenarios/datasets/README.md. DIR gets JPEG "
-        "images, COCO keypoint files for BlazePose's 33 landmarks and COCO's 17 (boxes, "
-        "visibility, RLE masks), PNG masks "
-        "from MuJoCo's segmentation rendering, per-frame ground truth with case labels, the "
+        "images, COCO keypoint files for BlazePose's 33 landmarks and COCO's 17 (one "
+        "annotation per visible person per image: boxes, visibility, RLE masks), PNG masks "
+        "from MuJoCo's segmentation rendering, per-frame ground truth with case labels, "
+        "each run as a MOTChallenge sequence (mot/<run>: gt/gt.txt, seqinfo.ini), the "
         "pipeline's features in the authors' CSV columns, and a README card. Prints a size "
         "and time estimate first. Deterministic for the spec; run it again on the same DIR "
         "to resume.",

@@ -6,10 +6,15 @@ hold a slash, so the per-run files below nest a folder deeper). Every frame of a
 one image. For each run the folder gets:
 
 - images/<run>/<frame>.jpg: the robot camera's frame (JPEG, quality 90);
-- masks/<run>/<frame>.png: the pedestrian's pixels from MuJoCo's segmentation rendering
-  (0/255; occluders hide it as in the image);
+- masks/<run>/<frame>.png: the scripted pedestrian's pixels from MuJoCo's segmentation
+  rendering (0/255; occluders, other people included, hide it as in the image); with
+  several people, masks/<run>/<frame>-<id>.png each other person's (id as in gt.txt);
 - truth/<run>.jsonl: one line per frame, GroundTruth.to_dict() plus the case label and
-  the image and mask file names (the intent labels, sim.world.intent, among the truth);
+  the image and mask file names (the intent labels, sim.world.intent, among the truth;
+  with several people a `people` list, every person's truth with name and visibility);
+- mot/<run>/: the run as a MOTChallenge sequence (sim.dataset.mot): gt/gt.txt, one
+  line per person per frame where the person is in the image, seqinfo.ini, and img1/
+  linking to the images numbered from 1;
 - features/<run>.csv: the pipeline's own per-frame output in the authors' log columns
   (monopic.framelog.AUTHORS_COLUMNS, then ours), the rows `monopic video --csv` writes
   whose authors' columns are all finite (not a track's first frame, which has no
@@ -19,9 +24,11 @@ one image. For each run the folder gets:
 - runs/<run>.json: written last, the mark of a finished run (resuming skips it).
 
 Merged over the finished runs after every invocation: annotations/blazepose33.json and
-annotations/coco17.json (COCO keypoints: one 'person' per image where any of it is
-visible, box from the mask, visibility 0 outside the image, 1 hidden behind another
-object, 2 in view; RLE masks), frames.csv (one row per image), runs.csv and README.md
+annotations/coco17.json (COCO keypoints: one 'person' annotation per person per image
+where any pixel of that person is visible, box from that person's mask, visibility 0
+outside the image, 1 hidden behind another object, 2 in view; RLE masks; with several
+people in any run, every annotation names its person: `person`, `track_id`, `mask_file`),
+frames.csv (one row per image, the scripted pedestrian's truth), runs.csv and README.md
 (the card: what, how, counts, licence).
 
 The runs execute on the sweep's executors (sim.runs.executors: spawned local workers,
@@ -63,6 +70,7 @@ from monopic.predict.base import Mode
 from monopic.predict.rules import RulePredictor
 from sim.dataset.card import readme
 from sim.dataset.coco import SKELETONS, category, encode_mask, mask_box, select_keypoints
+from sim.dataset.mot import MOT, SEQINFO, clipped_box, gt_line, link_images, seqinfo
 from sim.dataset.spec import FORMAT_VERSION, JPEG_QUALITY, DatasetRun, DatasetSpec, expand
 from sim.runs.estimate import (
     DATASET_START_S,
@@ -72,8 +80,8 @@ from sim.runs.estimate import (
 )
 from sim.runs.loop import Listener, LoopFrame, OnBoard, run_loop
 from sim.runs.sweep import SweepSpec, run_missing
-from sim.scenario.spec import CameraSpec, Scenario
-from sim.world.ground_truth import GroundTruth
+from sim.scenario.spec import CameraSpec, Scenario, person_name
+from sim.world.ground_truth import GroundTruth, PersonTruth
 from sim.world.render import KeptRenderContext
 from sim.world.world import World
 
@@ -99,17 +107,30 @@ def dataset_pipeline(scenario: Scenario) -> Pipeline:
     return scenario_pipeline(scenario, [RulePredictor(mode=Mode.IMAGE)])
 
 
-def keypoints33(truth: GroundTruth, width: int, height: int) -> list[float]:
+def keypoints33(person: PersonTruth, width: int, height: int) -> list[float]:
     """Flat COCO [x, y, v] * 33: v 0 outside the image (x = y = 0), 1 occluded, 2 in view."""
     out: list[float] = []
-    for (u, v), hidden in zip(
-        truth.pedestrian.landmarks_px, truth.pedestrian.landmarks_occluded, strict=True
-    ):
+    for (u, v), hidden in zip(person.landmarks_px, person.landmarks_occluded, strict=True):
         if not (math.isfinite(u) and math.isfinite(v) and 0 <= u < width and 0 <= v < height):
             out += [0, 0, 0]
         else:
             out += [round(float(u), 2), round(float(v), 2), 1 if hidden else 2]
     return out
+
+
+# A bystander's annotation id: the image's id plus this times (their MOT id - 1), so the
+# scripted pedestrian's keeps the image's id (as with one person) and no two collide while
+# image ids, (run index + 1) * 10000 + frame, stay below it.
+PERSON_ID_STRIDE = 10**10
+# Annotation keys a dataset of one person per run leaves out (its files as before people).
+PERSON_KEYS = ("person", "track_id", "mask_file")
+
+
+def mask_name(run_id: str, frame: int, track_id: int) -> str:
+    """A person's mask file: the scripted pedestrian's (id 1) <frame>.png as always, the
+    others' <frame>-<id>.png."""
+    suffix = "" if track_id == 1 else f"-{track_id}"
+    return f"masks/{run_id}/{frame:04d}{suffix}.png"
 
 
 def _truth_line(run: DatasetRun, frame: int, image: str, mask: str, truth: GroundTruth) -> str:
@@ -139,6 +160,7 @@ class FrameWriter(Listener):
     images: list[dict[str, Any]] = field(default_factory=list)
     annotations: list[dict[str, Any]] = field(default_factory=list)
     truth_lines: list[str] = field(default_factory=list)
+    gt_lines: list[str] = field(default_factory=list)  # MOTChallenge gt.txt
     feature_rows: list[list[Any]] = field(default_factory=list)
     found: int = 0
 
@@ -151,12 +173,9 @@ class FrameWriter(Listener):
         scenario = run.scenario
         cam = scenario.robot.camera
         image_name = f"images/{run.id}/{k:04d}.jpg"
-        mask_name = f"masks/{run.id}/{k:04d}.png"
         bgr = cv2.cvtColor(frame.step.frame.image, cv2.COLOR_RGB2BGR)
         if not cv2.imwrite(str(out / image_name), bgr, [cv2.IMWRITE_JPEG_QUALITY, JPEG_QUALITY]):
             raise OSError(f"cannot write {out / image_name}")
-        mask = self.world.pedestrian_mask()
-        cv2.imwrite(str(out / mask_name), mask.astype(np.uint8) * 255)
         result = frame.results[FEATURES]
         assert result is not None
         self.found += int(result.pose.found)
@@ -174,28 +193,44 @@ class FrameWriter(Listener):
                 "run": run.id,
                 "frame": k,
                 "time": round(frame.step.time, 6),
-                "mask_file": mask_name,
+                "mask_file": mask_name(run.id, k, 1),
             }
         )
+        for track_id, person in enumerate(truth.people, start=1):
+            self._person(image_id, k, track_id, person)
+        self.truth_lines.append(_truth_line(run, k, image_name, mask_name(run.id, k, 1), truth))
+
+    def _person(self, image_id: int, k: int, track_id: int, person: PersonTruth) -> None:
+        """One person's mask, COCO annotation (if any pixel shows) and gt.txt line (if in
+        the image)."""
+        assert self.world is not None
+        cam = self.run.scenario.robot.camera
+        name = mask_name(self.run.id, k, track_id)
+        mask = self.world.person_mask(person.name)
+        cv2.imwrite(str(self.out / name), mask.astype(np.uint8) * 255)
         area = int(mask.sum())
         if area > 0:
-            u0, v0, u1, v1 = truth.pedestrian.box
             self.annotations.append(
                 {
-                    "id": image_id,
+                    "id": image_id + (track_id - 1) * PERSON_ID_STRIDE,
                     "image_id": image_id,
                     "category_id": 1,
                     "iscrowd": 0,
                     "area": area,
                     "bbox": mask_box(mask),
-                    "amodal_bbox": _clipped_box(u0, v0, u1, v1, cam.width, cam.height),
+                    "amodal_bbox": clipped_box(person.box, cam.width, cam.height),
                     "segmentation": encode_mask(mask),
-                    "keypoints33": keypoints33(truth, cam.width, cam.height),
-                    "case": int(truth.pedestrian.case),
-                    "occluded": bool(truth.pedestrian.occluded),
+                    "keypoints33": keypoints33(person, cam.width, cam.height),
+                    "case": int(person.case),
+                    "occluded": bool(person.occluded),
+                    "person": person.name,
+                    "track_id": track_id,
+                    "mask_file": name,
                 }
             )
-        self.truth_lines.append(_truth_line(run, k, image_name, mask_name, truth))
+        line = gt_line(k + 1, track_id, person, cam.width, cam.height)
+        if line is not None:
+            self.gt_lines.append(line)
 
 
 def render_run(run: DatasetRun, out: Path, kept: KeptRenderContext | None = None) -> dict[str, Any]:
@@ -209,6 +244,8 @@ def render_run(run: DatasetRun, out: Path, kept: KeptRenderContext | None = None
     for sub in ("images", "masks"):
         shutil.rmtree(out / sub / run.id, ignore_errors=True)  # a partial earlier attempt
         (out / sub / run.id).mkdir(parents=True)
+    sequence = out / MOT / run.id
+    shutil.rmtree(sequence, ignore_errors=True)
     for sub in ("truth", "features", "runs"):  # a sweep's run ids nest: <scenario>/<draw>-…
         (out / sub / run.id).parent.mkdir(parents=True, exist_ok=True)
     writer = FrameWriter(run, out)
@@ -223,12 +260,19 @@ def render_run(run: DatasetRun, out: Path, kept: KeptRenderContext | None = None
     csv_writer.writerow(FEATURE_COLUMNS)
     csv_writer.writerows(writer.feature_rows)
     write_text_atomically(out / "features" / f"{run.id}.csv", buf.getvalue())
+    link_images(sequence, [out / image["file_name"] for image in writer.images])
+    fps = 1.0 / scenario.dt
+    info = seqinfo(run.id, fps, len(writer.images), cam.width, cam.height)
+    write_text_atomically(sequence / SEQINFO, info)
+    (sequence / "gt").mkdir(parents=True, exist_ok=True)
+    write_text_atomically(sequence / "gt" / "gt.txt", "".join(f"{x}\n" for x in writer.gt_lines))
     record = {
         "format": FORMAT_VERSION,
         "id": run.id,
         "index": run.index,
         "scenario": scenario.name,
         "params": run.params,
+        "people": [person_name(p, i) for i, p in enumerate(scenario.people)],
         "frames": len(writer.images),
         "pose_found": writer.found,
         "feature_rows": len(writer.feature_rows),
@@ -266,19 +310,13 @@ def work(task: DatasetTask, kept: KeptRenderContext | None = None) -> dict[str, 
         return {"id": task.id, "error": traceback.format_exc()}
 
 
-def _clipped_box(u0: float, v0: float, u1: float, v1: float, w: int, h: int) -> list[float] | None:
-    if not all(math.isfinite(v) for v in (u0, v0, u1, v1)):
-        return None
-    x0, y0 = min(max(u0, 0.0), w), min(max(v0, 0.0), h)
-    x1, y1 = min(max(u1, 0.0), w), min(max(v1, 0.0), h)
-    return [round(x0, 2), round(y0, 2), round(x1 - x0, 2), round(y1 - y0, 2)]
-
-
 def _run_bytes(out: Path, run_id: str) -> int:
     total = 0
     for sub in ("images", "masks"):
         total += sum(p.stat().st_size for p in (out / sub / run_id).iterdir())
-    for name in (f"truth/{run_id}.jsonl", f"features/{run_id}.csv"):
+    names = (f"truth/{run_id}.jsonl", f"features/{run_id}.csv", f"{MOT}/{run_id}/{SEQINFO}",
+             f"{MOT}/{run_id}/gt/gt.txt")  # fmt: skip
+    for name in names:
         total += (out / name).stat().st_size
     return total
 
@@ -348,7 +386,10 @@ def finished_runs(out: Path, runs: list[DatasetRun]) -> dict[str, dict[str, Any]
             record = json.loads(path.read_text(encoding="utf-8"))
         except json.JSONDecodeError:
             continue  # written atomically, so only a foreign file gets here: redo the run
-        if record.get("format") == FORMAT_VERSION and record.get("params") == run.params:
+        if record.get("format") != FORMAT_VERSION or record.get("params") != run.params:
+            continue
+        # A run rendered before the MOT sequences were written is rendered again.
+        if (out / MOT / run.id / "gt" / "gt.txt").is_file():
             done[run.id] = record
     return done
 
@@ -386,7 +427,7 @@ def prepare_folder(spec: DatasetSpec, out: Path) -> None:
     """Create the folder, or check that it holds the same spec's dataset (resume)."""
     if check_folder(spec, out):
         return
-    for sub in ("images", "masks", "truth", "features", "runs", "annotations"):
+    for sub in ("images", "masks", "truth", "features", "runs", "annotations", MOT):
         (out / sub).mkdir(parents=True, exist_ok=True)
     write_text_atomically(out / "spec.toml", spec.text)
     for name, text in spec.scenario_files:
@@ -476,6 +517,8 @@ def merge(spec: DatasetSpec, out: Path, records: list[dict[str, Any]]) -> dict[s
     """Write the COCO files, frames.csv, runs.csv and README.md from the run records."""
     images = [img for r in records for img in r["images"]]
     anns = [a for r in records for a in r["annotations"]]
+    if not any(len(r["people"]) > 1 for r in records):  # every run of one person: as before
+        anns = [{k: v for k, v in a.items() if k not in PERSON_KEYS} for a in anns]
     for skeleton in SKELETONS:
         coco = {
             "info": {
@@ -503,6 +546,7 @@ def merge(spec: DatasetSpec, out: Path, records: list[dict[str, Any]]) -> dict[s
         "keypoints_visible": visibility.get(2, 0),
         "keypoints_occluded": visibility.get(1, 0),
         "keypoints_outside": visibility.get(0, 0),
+        "people": sorted({len(r["people"]) for r in records}),
         "cases": dict(sorted(case_counts.items())),
     }
     if isinstance(spec.source, SweepSpec):
@@ -574,4 +618,5 @@ def _runs_csv(spec: DatasetSpec, records: list[dict[str, Any]]) -> str:
 
 
 def _folder_bytes(out: Path) -> int:
-    return sum(p.stat().st_size for p in out.rglob("*") if p.is_file())
+    """The bytes of the folder's files (the MOT sequences' links to the images not again)."""
+    return sum(p.stat().st_size for p in out.rglob("*") if p.is_file() and not p.is_symlink())

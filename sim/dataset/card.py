@@ -24,6 +24,8 @@ def readme(spec: DatasetSpec, counts: dict[str, Any]) -> str:
     keypoints = " / ".join(
         str(counts[k]) for k in ("keypoints_visible", "keypoints_occluded", "keypoints_outside")
     )
+    people = counts.get("people") or [1]
+    per_run = str(people[0]) if len(people) == 1 else f"{people[0]} to {people[-1]}"
     return f"""# {spec.name}: a synthetic pedestrian dataset from the MonoPIC test bed
 
 {spec.description}
@@ -36,7 +38,8 @@ def readme(spec: DatasetSpec, counts: dict[str, Any]) -> str:
 | --- | --- |
 | runs | {counts["runs"]} |
 | images | {counts["images"]} ({image_format}) |
-| person annotations (any pixel visible) | {counts["annotations"]} |
+| people per run | {per_run} |
+| person annotations (one per person per image where any pixel shows) | {counts["annotations"]} |
 | keypoints in view / occluded / outside the image | {keypoints} |
 | frames where the pipeline found the pose | {counts["pose_found"]} |
 | pipeline feature rows | {counts["feature_rows"]} |
@@ -57,21 +60,45 @@ between invocations. Resumable: finished runs (`runs/<run>.json`) are skipped.
 
 ## Files
 
-- `images/<run>/<frame>.jpg`, `masks/<run>/<frame>.png` (0 background, 255 pedestrian,
-  from MuJoCo's segmentation rendering; other objects hide it as in the image);
+- `images/<run>/<frame>.jpg`, `masks/<run>/<frame>.png` (0 background, 255 the
+  scenario's scripted pedestrian, from MuJoCo's segmentation rendering; other objects
+  and people hide it as in the image); with several people in a run, each other person's
+  mask beside it, `masks/<run>/<frame>-<id>.png` (id as in `gt.txt` below);
 - `annotations/blazepose33.json`, `annotations/coco17.json`: COCO keypoint files (one
-  category, `person`; `file_name` relative to this folder; `bbox` from the mask;
-  `segmentation` as COCO compressed RLE; keypoints `[x, y, v]` in pixels with v = 0
-  outside the image, 1 hidden by another object (a MuJoCo ray test), 2 in view; the body
-  hiding itself is not marked; `amodal_bbox` is the whole body's box clipped to the
-  image). COCO-17 keypoints are BlazePose's landmarks of the same names. Images where
-  no pixel of the person shows have no annotation;
+  category, `person`; `file_name` relative to this folder). Every person in the scene is
+  annotated: one annotation per person per image where any pixel of that person shows
+  (someone wholly hidden or outside the image has none), each from that person's own
+  mask: `bbox` the box of the visible pixels, `area` their count, `segmentation` as COCO
+  compressed RLE; keypoints `[x, y, v]` in pixels with v = 0 outside the image, 1 hidden
+  by another object or person (a MuJoCo ray test), 2 in view (the body hiding itself is
+  not marked), `num_keypoints` those with v > 0; `amodal_bbox` the whole body's box
+  clipped to the image. `iscrowd` is always 0: COCO sets 1 only on one region covering
+  a crowd annotated as a whole, and here each person is annotated apart, however they
+  overlap. When any run holds several people every annotation also names its person:
+  `person` (the name in the scenario, `ped` for the scripted pedestrian), `track_id`
+  (their id in `gt.txt`) and `mask_file`; COCO tools ignore these fields. Annotation
+  ids: the image's id for the scripted pedestrian, plus (track_id - 1) x 10^10 for the
+  others. COCO-17 keypoints are BlazePose's landmarks of the same names;
+- `mot/<run>/`: the run as a MOTChallenge sequence folder (`monopic track-eval TRACKS
+  --gt mot/<run>` reads it, `monopic video mot/<run>` plays it): `gt/gt.txt`, one line
+  per person per frame where any of the body is inside the image,
+  `frame,id,bb_left,bb_top,bb_width,bb_height,1,1,visibility` (frames from 1; id 1 the
+  scripted pedestrian, then 2, 3, ... for the others, the same all run; the whole body's
+  box clipped to the image, occlusion ignored; conf 1, class 1 pedestrian; visibility
+  the share of the body's surface the camera sees, 0 for someone wholly hidden, who
+  keeps their line as MOTChallenge keeps occluded people); `seqinfo.ini` (name,
+  imDir, frameRate, seqLength, imWidth, imHeight, imExt); `img1/000001.jpg` ...:
+  relative links to `images/<run>/0000.jpg` ..., numbered from 1 as the gt counts frames;
 - `truth/<run>.jsonl`: per frame, the simulator's ground truth (`sim.world.ground_truth.
-  GroundTruth.to_dict()`: positions in the world and the robot frame, velocities, case,
-  true phi, time to collision, collision, contact, landmark pixels, occlusion, and the
-  labels `case_now` (the case of the velocity now) and `intent` (keep going, stop, turn
-  away or start crossing within the horizon; `intent_time` s until it happens);
-- `frames.csv`: one row per image with the main truth columns and those labels;
+  GroundTruth.to_dict()`: the scripted pedestrian's positions in the world and the robot
+  frame, velocities, case, true phi, time to collision, collision, contact, landmark
+  pixels, occlusion, and the labels `case_now` (the case of the velocity now) and
+  `intent` (keep going, stop, turn away or start crossing within the horizon;
+  `intent_time` s until it happens); with several people, `people` holds each person's
+  the same way, with their name, footprint and visibility);
+- `frames.csv`: one row per image with the scripted pedestrian's main truth columns and
+  those labels (every person's truth is in `truth/<run>.jsonl`, under `people`, when a
+  run holds several);
 - `features/<run>.csv`: the pipeline's own output per frame with a pose, in the MonoPIC
   authors' log columns then ours (as `monopic video --csv` writes), leaving out rows
   without a velocity yet (a track's first frame); `monopic tree train` and `monopic

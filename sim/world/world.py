@@ -194,6 +194,17 @@ class World(Closing):
             self._renderer = SceneRenderer(self.scene, context=self.render_context)
         return self._renderer.mask(self.scene.geoms_of(self.scene.pedestrians[0]))
 
+    def person_mask(self, name: str) -> np.ndarray:
+        """Pixels where the person `name` (PersonTruth.name) is visible in the current image
+        (bool, H x W); other people and objects hide them as in the image."""
+        body = next((p for p in self.scene.pedestrians if p.name == name), None)
+        if body is None:
+            names = [p.name for p in self.scene.pedestrians]
+            raise KeyError(f"no person named {name!r} in the scene (people: {names})")
+        if self._renderer is None:
+            self._renderer = SceneRenderer(self.scene, context=self.render_context)
+        return self._renderer.mask(self.scene.geoms_of(body))
+
     def close(self) -> None:
         if self._renderer is not None:
             self._renderer.close()
