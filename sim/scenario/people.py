@@ -41,9 +41,12 @@ class CarContact:
 
 def planned_path(person: PedestrianSpec, s: Scenario) -> Track:
     """A person's path as written: their plan walked by the rail target (their own walker
-    when it is one), meeting the placement's anchor as theirs does."""
-    if not isinstance(person.behaviour, RailWalker):
-        person = replace(person, behaviour=RailWalker())
+    when it is one), starting from standing over their walker's start distance (the one
+    the placement timed the plan with), so it meets the placement's anchor as theirs does."""
+    walker = person.behaviour
+    if not isinstance(walker, RailWalker):
+        rail = RailWalker(acceleration_distance=walker.start_distance)
+        person = replace(person, behaviour=rail)
     return pedestrian_path(person, s.duration, s.seed)
 
 
