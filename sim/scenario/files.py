@@ -538,6 +538,7 @@ def given_problem(data: Mapping[str, Any], g: Given) -> str | None:
     """Why a value given on the command line cannot apply to the scenario of `data` (None:
     it applies): a case placement's keys need a case path, a standing person has no speed."""
     scripted = entries(data)[0] if listed(data) else data
+    scripted = scripted if isinstance(scripted, dict) else {}
     path = scripted.get("path") if isinstance(scripted.get("path"), dict) else {}
     kind = path.get("kind")
     if g.key.startswith("path.") and kind != "case":
