@@ -11,6 +11,7 @@ A sweep spec (scenarios/sweeps/*.toml, documented in scenarios/README.md):
     sampling = "random"             # "file" (as each file says), "base", "grid", "random"
     runs = 3                        # random draws per file (random sampling only)
     seed = 7
+    people = "../people/pavement_pair.toml"  # optional: bystanders every run of these adds
     [include.parameters]            # add or replace sweep parameters of those files
     "robot.speed" = [0.0, 8.33]     # (with "base": a grid over these alone)
 
@@ -43,13 +44,17 @@ from sim.runs.result import SCHEMA
 from sim.runs.results_file import ResultsState, ResultsWriter, check_unlocked, read_rows, scan
 from sim.runs.run_spec import RunSpec
 from sim.scenario.files import (
+    PEOPLE_KEY,
     ScenarioFile,
     ScenarioFileError,
     Sweep,
+    Values,
     expand,
     is_scenario_file,
     load,
     parse_parameters,
+    people_files,
+    read_people,
     unsweepable,
 )
 from sim.scenario.spec import Scenario, scenario_text
@@ -68,6 +73,9 @@ class Include:
     runs: int | None = None
     seed: int | None = None
     parameters: dict[str, Any] = field(default_factory=dict)
+    # People files (of [[pedestrians]] entries) every run of these files adds after the
+    # file's own people: bystanders for a family without copying it.
+    people: tuple[Path, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -135,12 +143,67 @@ def parse_spec(
             if reason is not None:
                 field = f"{entry.field('parameters')}.{key}"
                 raise ScenarioFileError(path, field, entry.data["parameters"][key], reason)
+        _check_people_parameter(entry, path, parameters.get(PEOPLE_KEY))
+        people = _people(entry, path, entry.raw(PEOPLE_KEY, None), entry.field(PEOPLE_KEY))
         entry.done()
-        includes.append(Include(tuple(files), sampling, runs, seed, parameters))
+        includes.append(Include(tuple(files), sampling, runs, seed, parameters, people))
     top.done()
     if not includes:
         raise ScenarioFileError(path, "include", [], "a sweep needs at least one [[include]]")
     return SweepSpec(path, name, description, ablation, tuple(includes), licence, intent_tree)
+
+
+def _people(entry: TomlTable, spec: Path, value: Any, field: str) -> tuple[Path, ...]:
+    """The people files an include names (relative to the spec), each read now: a file
+    that is not one is refused before any run."""
+    if value is None:
+        return ()
+    files = people_files(spec, value, field)
+    for file in files:
+        read_people(file)
+    return files
+
+
+def _check_people_parameter(entry: TomlTable, spec: Path, dist: Any) -> None:
+    """A swept `people` in [include.parameters]: a set of people files (relative to the
+    spec, "" for none), each there and a people file."""
+    if dist is None:
+        return
+    field = f"{entry.field('parameters')}.{PEOPLE_KEY}"
+    if not isinstance(dist, Values) or not all(isinstance(v, str) for v in dist.values):
+        raise ScenarioFileError(
+            spec, field, entry.data["parameters"][PEOPLE_KEY],
+            'must be a list of people files (relative to the spec; "" for none)',
+        )  # fmt: skip
+    for value in dist.values:
+        _people(entry, spec, value, field)
+
+
+def _with_people(
+    params: dict[str, Any], include: Include, file: ScenarioFile, spec: Path
+) -> dict[str, Any]:
+    """A run's values with the include's people: `people` names the file's own people
+    files, then the include's swept ones, then its `people`, each relative to the scenario
+    file (as the file's own key is; a rerun rebuilds the run from the file and these
+    values). Values of an include without people are as they were (their run ids too)."""
+    swept = PEOPLE_KEY in include.parameters
+    if not include.people and not swept:
+        return params
+    out = dict(params)
+    written = file.data.get(PEOPLE_KEY, "")  # the file's own key (its sweep may vary it)
+    own = written if swept else out.get(PEOPLE_KEY, written)
+    names = [n for n in (own if isinstance(own, list) else [own]) if n]
+    added = (*(people_files(spec, out[PEOPLE_KEY]) if swept else ()), *include.people)
+    names += [_relative(p, file.path) for p in added]
+    out[PEOPLE_KEY] = names if len(names) != 1 else names[0]
+    if not names:
+        out[PEOPLE_KEY] = ""  # a swept "": none
+    return out
+
+
+def _relative(path: Path, file: Path) -> str:
+    """`path` as written from the folder of `file` (forward slashes)."""
+    return Path(os.path.relpath(path, file.parent)).as_posix()
 
 
 def _intent_tree(top: TomlTable, path: Path) -> Path | None:
@@ -218,7 +281,8 @@ def expand_spec(spec: SweepSpec) -> list[RunSpec]:
             except ValueError as err:
                 raise ScenarioFileError(path, "sweep", include.sampling, str(err)) from None
             drawn: set[tuple[str, int]] = set()
-            for index, params in enumerate(combos):
+            for index, combo in enumerate(combos):
+                params = _with_people(combo, include, file, spec.path)
                 built, probe, digest = run_scenario(file, params)
                 rid = run_id(file, index, digest)
                 # The same scenario twice (e.g. a walking speed swept for a person who

@@ -197,6 +197,31 @@ class Longitudinal:
     standstill_distance: float = 4.0
 
 
+class Along(StrEnum):
+    """Which way a person on the pavement faces or walks."""
+
+    AWAY = "away"  # east, with the robot
+    TOWARD = "toward"  # west, against it
+    ROAD = "road"  # across, facing the road (standing only)
+
+
+# Where a person on the pavement stands by default: this far behind the kerb line, the
+# middle of the default 3 m pavement.
+PAVEMENT_FROM_KERB = 1.5  # m
+
+
+@dataclass(frozen=True)
+class Pavement:
+    """A person on the pavement of `side`: at `x` at the start, `from_kerb` metres behind
+    the kerb line (the road's edge), standing or walking along it; placed on the street,
+    not against the robot (a bystander's placement: no anchor, no case)."""
+
+    side: Side
+    x: float
+    from_kerb: float = PAVEMENT_FROM_KERB
+    along: Along | None = None  # None: facing the road when standing, else walking away
+
+
 class PlacementError(ValueError):
     """A placement that cannot be built; `field` names the offending path key."""
 
@@ -376,6 +401,33 @@ def place_turn_in(
         footprint=footprint,
         behaviour=behaviour or RailWalker(),
         anchor=Anchor(c.impact_time, x_line, y_impact),
+    )
+
+
+def place_pavement(
+    c: Pavement, road: RoadLayout, speed: float, looks: MannequinSpec,
+    footprint: float = presets.FOOTPRINT, behaviour: Walker | None = None,
+) -> PedestrianSpec:  # fmt: skip
+    """The person of a Pavement placement: standing there (speed 0) or walking along the
+    pavement at `speed` the whole run."""
+    along = c.along or (Along.ROAD if speed == 0 else Along.AWAY)
+    if along is Along.ROAD and speed > 0:
+        raise PlacementError(
+            "path.direction", along.value, "a person walking along the pavement walks away or "
+            "toward (facing the road is for a person who stands: speed = 0)",
+        )  # fmt: skip
+    y_right, y_left = road.edges
+    near = c.side is Side.NEAR
+    y = y_right - c.from_kerb if near else y_left + c.from_kerb
+    headings = {Along.AWAY: 0.0, Along.TOWARD: 180.0, Along.ROAD: 90.0 if near else -90.0}
+    return PedestrianSpec(
+        x=c.x,
+        y=y,
+        heading_deg=headings[along],
+        speed=speed,
+        looks=looks,
+        footprint=footprint,
+        behaviour=behaviour or RailWalker(),
     )
 
 

@@ -29,9 +29,12 @@ from sim.scenario.families import (
     CLOTHING,
     HESITATE_SPEED,
     HESITATE_TIME,
+    PAVEMENT_FROM_KERB,
     SCALES,
+    Along,
     Crossing,
     Longitudinal,
+    Pavement,
     PlacementError,
     Scale,
     Side,
@@ -42,12 +45,19 @@ from sim.scenario.families import (
     parked_cars_around,
     place_crossing,
     place_longitudinal,
+    place_pavement,
     place_turn_in,
     street_bounds,
 )
 from sim.scenario.lighting import FILE_DEFAULT, Lighting
 from sim.scenario.lighting import PRESETS as LIGHTING
 from sim.scenario.path import pedestrian_path
+from sim.scenario.people import (
+    parked_car_contact,
+    parked_car_text,
+    planned_path,
+    start_overlap,
+)
 from sim.scenario.spec import (
     BodyPitch,
     CameraSpec,
@@ -58,12 +68,13 @@ from sim.scenario.spec import (
     RobotSpec,
     Scenario,
     SceneSpec,
+    person_name,
 )
 from sim.scenario.toml_table import MISSING, FieldError, TomlTable, read_toml, show
 from sim.scenario.walkers import Walker, walker_from_table
 
 KINDS = ("case", "collision", "near-miss")
-PATH_KINDS = ("case", "crossing", "longitudinal", "turn-in", "explicit")
+PATH_KINDS = ("case", "crossing", "longitudinal", "turn-in", "explicit", "pavement")
 SAMPLING = ("grid", "random")
 MAX_GRID_RUNS = 100_000
 
@@ -72,8 +83,9 @@ ScenarioFileError = FieldError  # the name callers of this module know
 
 # Top-level keys by which a scenario file and a sweep spec tell themselves apart, so that
 # one given for the other is named for what it is, not for its first unknown key.
-SCENARIO_FILE_KEYS = ("path", "pedestrian", "robot", "scene", "sweep", "family", "kind",
-                      "scale", "duration", "fps", "horizon", "seed")  # fmt: skip
+SCENARIO_FILE_KEYS = ("path", "pedestrian", "pedestrians", "people", "robot", "scene",
+                      "sweep", "family", "kind", "scale", "duration", "fps", "horizon",
+                      "seed")  # fmt: skip
 SWEEP_SPEC_KEY = "include"
 
 
@@ -236,9 +248,9 @@ class ScenarioFile:
         """The scenario with `params` (dotted keys) set; errors name the file and field.
 
         `seed` replaces the file's (or a swept) seed; None keeps it."""
-        data = with_values(self.data, params)
+        data, origins = applied(self.path, self.data, params)
         try:
-            scenario = build(self.path, data)
+            scenario = build(self.path, data, origins)
         except ScenarioFileError as err:
             if not params:
                 raise
@@ -258,7 +270,8 @@ class ScenarioFile:
             if problem is not None:
                 raise UserError(f"{g.text}: {self.path}: {problem}")
         try:
-            scenario = build(self.path, with_values(self.data, {g.key: g.value for g in given}))
+            data, origins = applied(self.path, self.data, {g.key: g.value for g in given})
+            scenario = build(self.path, data, origins)
         except ScenarioFileError as err:
             raise UserError(f"{' '.join(g.text for g in given)}: {err}") from None
         return replace(scenario, name=name or self.name)
@@ -267,18 +280,173 @@ class ScenarioFile:
         return expand(self.sweep, self.name)
 
 
-def with_values(data: Mapping[str, Any], params: Mapping[str, Any]) -> dict[str, Any]:
-    """A deep copy of a file's data with dotted keys set (tables created as needed)."""
+def with_values(
+    data: Mapping[str, Any], params: Mapping[str, Any], file: Path | str = "<data>"
+) -> dict[str, Any]:
+    """A deep copy of a file's data with dotted keys set (tables created as needed).
+
+    A person's key has their index in the file's people (`pedestrians.1.speed`; 0 is the
+    scripted person, wherever the file writes them); `pedestrian.*` and `path.*` are the
+    scripted person's in either form. A person the data does not hold is a FieldError
+    naming `file`, the key and how many people there are."""
     out = copy.deepcopy(dict(data))
     for key, value in params.items():
-        node = out
-        parts = key.split(".")
-        for part in parts[:-1]:
-            node = node.setdefault(part, {})
-            if not isinstance(node, dict):
+        node: Any = out
+        parts = located(out, key, value, file)
+        for part, inner in zip(parts[:-1], parts[1:], strict=True):
+            node = node[part] if isinstance(part, int) else node.setdefault(part, {})
+            if not isinstance(node, list if isinstance(inner, int) else dict):
                 raise ValueError(f"{key}: {part} is not a table")
         node[parts[-1]] = value
     return out
+
+
+def applied(
+    path: Path, data: Mapping[str, Any], params: Mapping[str, Any]
+) -> tuple[dict[str, Any], dict[int, str]]:
+    """A file's data with `params` set, its people files read in first (a swept `people`
+    among them) so that a key can name any person; and where each added person comes
+    from (resolve_people)."""
+    first = {k: v for k, v in params.items() if k == PEOPLE_KEY}
+    rest = {k: v for k, v in params.items() if k != PEOPLE_KEY}
+    resolved, origins = resolve_people(path, with_values(data, first, path))
+    return with_values(resolved, rest, path), origins
+
+
+# -- people ---------------------------------------------------------------------------
+
+# A scenario file's people: the scripted person (person 0) is [pedestrian] with [path], or
+# the first [[pedestrians]] entry when the file has neither table; the [[pedestrians]]
+# entries follow, then the entries of the files the top-level `people` key names.
+PEOPLE_KEY = "people"
+PERSON_KEY = "pedestrians"
+
+
+def listed(data: Mapping[str, Any]) -> bool:
+    """Whether the scripted person is the first [[pedestrians]] entry (the file has no
+    [pedestrian] and no [path] table)."""
+    return "pedestrian" not in data and "path" not in data and bool(entries(data))
+
+
+def entries(data: Mapping[str, Any]) -> list[Any]:
+    """The [[pedestrians]] entries of a file's data (none when it has no list there)."""
+    value = data.get(PERSON_KEY)
+    return value if isinstance(value, list) else []
+
+
+def people_names(data: Mapping[str, Any]) -> list[str]:
+    """Each person's name in a file's data, by index (person_name's defaults)."""
+    rows = entries(data)
+    if not listed(data):
+        table = data.get("pedestrian")
+        rows = [table if isinstance(table, dict) else {}, *rows]
+    names = []
+    for k, row in enumerate(rows):
+        given = row.get("name") if isinstance(row, dict) else None
+        names.append(given if isinstance(given, str) and given else person_name_of(k))
+    return names
+
+
+def person_name_of(index: int) -> str:
+    """The name of an unnamed person at `index` (spec.person_name's)."""
+    return person_name(PedestrianSpec(0.0, 0.0, 0.0, 0.0), index)
+
+
+def located(data: Mapping[str, Any], key: str, value: Any, file: Path | str) -> list[str | int]:
+    """Where a dotted key lands in a file's data: its parts, a person's by their index."""
+    parts: list[str | int] = list(key.split("."))
+    is_listed = listed(data)
+    if parts[0] != PERSON_KEY:
+        if is_listed and parts[0] in ("pedestrian", "path"):  # the scripted person
+            inner = parts[1:] if parts[0] == "pedestrian" else ["path", *parts[1:]]
+            return [PERSON_KEY, 0, *inner]
+        return parts
+    names = people_names(data)
+    if len(parts) < 3 or not str(parts[1]).isdigit():
+        raise FieldError(
+            file, key, value,
+            f"a person's key is pedestrians.INDEX.KEY (e.g. pedestrians.1.speed; index 0 is "
+            f"the scripted person; the file has {len(names)} "
+            f"{'person' if len(names) == 1 else 'people'})",
+        )  # fmt: skip
+    index, inner = int(parts[1]), parts[2:]
+    if index >= len(names):
+        shown = ", ".join(f"{k} {n!r}" for k, n in enumerate(names))
+        people = "person" if len(names) == 1 else "people"
+        raise FieldError(
+            file, key, value, f"no person {index}: the file has {len(names)} {people} ({shown})"
+        )
+    if is_listed:
+        return [PERSON_KEY, index, *inner]
+    if index > 0:
+        return [PERSON_KEY, index - 1, *inner]
+    return ["path", *inner[1:]] if inner[0] == "path" else ["pedestrian", *inner]
+
+
+def field_of(data: Mapping[str, Any], key: str) -> str:
+    """The dotted field a build names for a key: a person's key as their table is named
+    (`pedestrian.speed` is `pedestrians.0.speed` in a file that lists its scripted
+    person; `pedestrians.0.speed` is `pedestrian.speed` in one that does not)."""
+    try:
+        parts = located(data, key, None, "")
+    except FieldError:
+        return key
+    if parts[0] == PERSON_KEY and len(parts) > 1 and isinstance(parts[1], int):
+        parts = [PERSON_KEY, parts[1] + (0 if listed(data) else 1), *parts[2:]]
+    return ".".join(str(p) for p in parts)
+
+
+def people_files(path: Path, value: Any, field: str = PEOPLE_KEY) -> tuple[Path, ...]:
+    """The people files a `people` value names: one file or a list of them, relative to
+    the folder of `path` ("" names none); each must be there."""
+    names = value if isinstance(value, list) else [value]
+    if not all(isinstance(n, str) for n in names):
+        raise FieldError(path, field, value, "must be a people file or a list of them "
+                         "(relative to this file; \"\" for none)")  # fmt: skip
+    out = []
+    for name in names:
+        if not name:
+            continue
+        found = Path(name) if Path(name).is_absolute() else Path(path).parent / name
+        if not found.is_file():
+            raise FieldError(path, field, value, f"no such people file ({found})")
+        out.append(found)
+    return tuple(out)
+
+
+def read_people(path: Path) -> list[dict[str, Any]]:
+    """The [[pedestrians]] entries of a people file (it holds those and a description)."""
+    _, data = read_toml(path, "people file")
+    top = TomlTable(path, "", data, "scenarios/README.md")
+    top.text("description", "")
+    value = top.raw(PERSON_KEY, MISSING, "[[pedestrians]] entries")
+    if not (isinstance(value, list) and value and all(isinstance(v, dict) for v in value)):
+        raise top.error(PERSON_KEY, value, "must be one or more [[pedestrians]] entries")
+    top.done()
+    return value
+
+
+def resolve_people(path: Path, data: Mapping[str, Any]) -> tuple[dict[str, Any], dict[int, str]]:
+    """A file's data with the entries of the people files its `people` key names appended
+    to its [[pedestrians]] (and `people` gone), and where each added person comes from, by
+    their index ("pedestrians[0] of FILE"). Data without `people` is returned as it is."""
+    out = dict(data)
+    if PEOPLE_KEY not in out:
+        return out, {}
+    files = people_files(path, out.pop(PEOPLE_KEY))
+    own = out.get(PERSON_KEY, [])
+    if not (isinstance(own, list) and all(isinstance(v, dict) for v in own)):
+        raise FieldError(path, PERSON_KEY, own, "must be a list of tables ([[pedestrians]] "
+                         "entries)")  # fmt: skip
+    index = len(own) + (0 if listed(out) else 1)
+    added: list[dict[str, Any]] = []
+    origins: dict[int, str] = {}
+    for file in files:
+        for j, entry in enumerate(read_people(file)):
+            origins[index + len(added)] = f"pedestrians[{j}] of {file}"
+            added.append(copy.deepcopy(entry))
+    out[PERSON_KEY] = [*own, *added]
+    return out, origins
 
 
 def load(path: Path | str) -> ScenarioFile:
@@ -315,9 +483,9 @@ def _check_parameters(path: Path, data: dict[str, Any], sweep: Sweep) -> None:
         values = dist.grid() if isinstance(dist, Values) or dist.steps else (dist.low, dist.high)
         for value in values:
             try:
-                build(path, with_values(data, {key: value}))
+                build(path, *applied(path, data, {key: value}))
             except ScenarioFileError as err:
-                if err.field == key or err.reason.startswith("unknown key"):
+                if err.field in (key, field_of(data, key)) or err.reason.startswith("unknown key"):
                     raise ScenarioFileError(
                         path, f"sweep.parameters.{key}", value, err.reason
                     ) from None
@@ -369,7 +537,9 @@ class Given:
 def given_problem(data: Mapping[str, Any], g: Given) -> str | None:
     """Why a value given on the command line cannot apply to the scenario of `data` (None:
     it applies): a case placement's keys need a case path, a standing person has no speed."""
-    path = data.get("path") if isinstance(data.get("path"), dict) else {}
+    scripted = entries(data)[0] if listed(data) else data
+    scripted = scripted if isinstance(scripted, dict) else {}
+    path = scripted.get("path") if isinstance(scripted.get("path"), dict) else {}
     kind = path.get("kind")
     if g.key.startswith("path.") and kind != "case":
         return (
@@ -452,8 +622,16 @@ def placed_case(
 # -- building a Scenario from a file's data -------------------------------------------
 
 
-def build(path: Path, data: Mapping[str, Any]) -> Scenario:
-    """Validate a file's data (without its sweep) and build the Scenario it describes."""
+def build(
+    path: Path, data: Mapping[str, Any], origins: Mapping[int, str] | None = None
+) -> Scenario:
+    """Validate a file's data (without its sweep) and build the Scenario it describes.
+
+    Its `people` files are read in (resolve_people) unless `data` comes without them,
+    `origins` then saying where its added people come from."""
+    if PEOPLE_KEY in data:
+        data, origins = resolve_people(path, data)
+    origins = origins or {}
     top = TomlTable(path, "", data)
     name = top.text("name")
     family = top.text("family", name)
@@ -472,28 +650,28 @@ def build(path: Path, data: Mapping[str, Any]) -> Scenario:
     seed = top.integer("seed", 0, high=2**31 - 1)
     robot = _robot(top.table("robot"), preset.robot)
     road, lighting = _scene(top.table("scene"), preset.road)
-    ped_table = top.table("pedestrian")
-    body = ped_table.text("body", "adult", BODIES)
-    clothing = ped_table.text("clothing", "default", tuple(CLOTHING))
-    height_low, height_high = presets.HEIGHT_RANGE
-    height = ped_table.number("height", None, low=height_low, high=height_high, unit="m")
-    speed = ped_table.number(
-        "speed", presets.PEDESTRIAN_SPEED, low=0.0, high=presets.MAX_PEDESTRIAN_SPEED, unit="m/s"
-    )
-    footprint = ped_table.number("footprint", presets.FOOTPRINT, positive=True, high=2.0, unit="m")
-    behaviour = walker_from_table(ped_table.table("behaviour"))  # scenarios/README.md
-    ped_table.done()
-    looks = mannequin(body, clothing, height)
-    path_table = top.table("path")
-    pedestrian, case, x_line = _path(
-        path_table, robot, road, speed, looks, footprint, duration, behaviour
-    )
+    tables = _people_tables(top)
+    people: list[PedestrianSpec] = []
+    case: Case | None = None
+    x_line: float | None = None
+    for k, (person_table, path_table) in enumerate(tables):
+        try:
+            person, case_k, x_line_k = _person(person_table, path_table, robot, road, duration)
+        except FieldError as err:
+            if k not in origins:
+                raise
+            reason = f"{err.reason} (person {k} is {origins[k]})"
+            raise FieldError(err.file, err.field, err.value, reason) from None
+        if k == 0:  # the scripted person: the scenario's case and crossing line
+            case, x_line = case_k, x_line_k
+        people.append(person)
     occluders = _parked_cars(top.table("scene").table("parked_cars"), x_line, robot, road)
     top.done()
+    _check_names(people, [t for t, _ in tables])
     scene = SceneSpec(occluders=occluders, road=road, lighting=lighting)
     scenario = Scenario(
         name=name,
-        pedestrian=pedestrian,
+        pedestrian=people[0],
         robot=robot,
         scene=scene,
         family=family,
@@ -502,9 +680,52 @@ def build(path: Path, data: Mapping[str, Any]) -> Scenario:
         dt=1.0 / fps,
         horizon=horizon,
         seed=seed,
+        bystanders=tuple(people[1:]),
     )
-    _check_on_street(path, scenario)
+    paths = [t.prefix for _, t in tables]
+    labels = [person_label(scenario, k, origins.get(k, "")) for k in range(len(people))]
+    _check_on_street(path, scenario, paths, labels)
+    _check_people(path, scenario, paths, labels)
     return scenario
+
+
+def _people_tables(top: TomlTable) -> list[tuple[TomlTable, TomlTable]]:
+    """Each person's table and their path's, the scripted person first: [pedestrian] and
+    [path] (as a file without [[pedestrians]] always had it), or the first [[pedestrians]]
+    entry of a file with neither table; then the [[pedestrians]] entries, named by their
+    index among the people (pedestrians.1, ...)."""
+    is_listed = listed(top.data)
+    value = top.raw(PERSON_KEY, [])
+    if not (isinstance(value, list) and all(isinstance(v, dict) for v in value)):
+        raise top.error(PERSON_KEY, value, "must be a list of tables ([[pedestrians]] entries)")
+    tables = [] if is_listed else [(top.table("pedestrian"), top.table("path"))]
+    first = len(tables)
+    for j, entry in enumerate(value):
+        t = TomlTable(top.file, f"{PERSON_KEY}.{first + j}", entry, top.doc)
+        tables.append((t, t.table("path")))
+    return tables
+
+
+def _person(
+    t: TomlTable, path_table: TomlTable, robot: RobotSpec, road: RoadLayout, duration: float
+) -> tuple[PedestrianSpec, Case | None, float | None]:
+    """One person: their table's looks, speed and walker, and their path (_path)."""
+    name = t.slug("name") if t.has("name") else ""
+    body = t.text("body", "adult", BODIES)
+    clothing = t.text("clothing", "default", tuple(CLOTHING))
+    height_low, height_high = presets.HEIGHT_RANGE
+    height = t.number("height", None, low=height_low, high=height_high, unit="m")
+    speed = t.number(
+        "speed", presets.PEDESTRIAN_SPEED, low=0.0, high=presets.MAX_PEDESTRIAN_SPEED, unit="m/s"
+    )
+    footprint = t.number("footprint", presets.FOOTPRINT, positive=True, high=2.0, unit="m")
+    behaviour = walker_from_table(t.table("behaviour"))  # scenarios/README.md
+    t.done()
+    looks = mannequin(body, clothing, height)
+    person, case, x_line = _path(
+        path_table, robot, road, speed, looks, footprint, duration, behaviour, t.prefix
+    )
+    return (replace(person, name=name) if name else person), case, x_line
 
 
 def _robot(t: TomlTable, preset: RobotSpec) -> RobotSpec:
@@ -600,8 +821,12 @@ def _path(
     footprint: float,
     duration: float,
     behaviour: Walker,
+    person: str = "pedestrian",
 ) -> tuple[PedestrianSpec, Case | None, float | None]:
-    """The pedestrian's path; also its case and (crossings) the crossing line's x."""
+    """The pedestrian's path; also its case and (crossings) the crossing line's x.
+
+    `person` is the dotted name of their table (a placement's refusal of their speed
+    names it)."""
     kind = t.text("kind", choices=PATH_KINDS)
     x_line = None
     try:
@@ -655,6 +880,16 @@ def _path(
                 raise PlacementError("pedestrian.speed", speed, "a walking pedestrian needs > 0")
             pedestrian = place_longitudinal(c2, robot, speed, looks, footprint, behaviour)
             case = Case.TOWARD if c2.toward else Case.AWAY
+        elif kind == "pavement":
+            along = t.text("direction", None, tuple(a.value for a in Along))
+            c4 = Pavement(
+                side=Side(t.text("side", choices=tuple(s.value for s in Side))),
+                x=t.number("x", unit="m"),
+                from_kerb=t.number("from_kerb", PAVEMENT_FROM_KERB, low=0.0, high=10.0, unit="m"),
+                along=None if along is None else Along(along),
+            )
+            pedestrian = place_pavement(c4, road, speed, looks, footprint, behaviour)
+            case = None
         else:
             leg_tables = t.tables("legs")
             legs = tuple(
@@ -682,9 +917,21 @@ def _path(
             )
             case = None
     except PlacementError as err:
-        raise ScenarioFileError(t.file, err.field, err.value, err.reason) from None
+        field = _placement_field(err.field, person, t.prefix)
+        raise ScenarioFileError(t.file, field, err.value, err.reason) from None
     t.done()
     return pedestrian, case, x_line
+
+
+def _placement_field(field: str, person: str, path: str) -> str:
+    """A placement's field (`pedestrian.speed`, `path.approach`) as this person's tables
+    are named (`pedestrians.1.speed`, `pedestrians.1.path.approach`)."""
+    head, _, rest = field.partition(".")
+    if head == "pedestrian":
+        return f"{person}.{rest}"
+    if head == "path":
+        return f"{path}.{rest}" if rest else path
+    return field
 
 
 # Where a CasePlacement parameter is set in a scenario file.
@@ -754,19 +1001,40 @@ class StreetError(ScenarioFileError):
     """A check of the whole scenario (street_problem): no single value is to blame."""
 
 
-def _check_on_street(path: Path, s: Scenario) -> None:
-    """The robot stays on its road and the pedestrian on the street for the whole run."""
-    problem = street_problem(s)
+def _check_on_street(
+    path: Path, s: Scenario, paths: Sequence[str] | None = None,
+    labels: Sequence[str] | None = None,
+) -> None:  # fmt: skip
+    """The robot stays on its road and everyone on the street for the whole run."""
+    problem = street_problem(s, paths, labels)
     if problem is not None:
         raise StreetError(path, problem.field, problem.value, problem.reason)
 
 
-def street_problem(s: Scenario) -> PlacementError | None:
-    """Why the scenario leaves its street (robot off its road or past its end, pedestrian
+def person_label(s: Scenario, index: int, origin: str = "") -> str:
+    """A person as an error names them: "the pedestrian" when they are alone, else by
+    index and name (and where an added person comes from)."""
+    if len(s.people) == 1:
+        return "the pedestrian"
+    where = f", {origin}" if origin else ""
+    return f"person {index} ({person_name(s.people[index], index)!r}{where})"
+
+
+def person_paths(s: Scenario) -> list[str]:
+    """Each person's path as a file with [pedestrian] and [path] names it."""
+    return ["path", *(f"{PERSON_KEY}.{k}.path" for k in range(1, len(s.people)))]
+
+
+def street_problem(
+    s: Scenario, paths: Sequence[str] | None = None, labels: Sequence[str] | None = None
+) -> PlacementError | None:
+    """Why the scenario leaves its street (robot off its road or past its end, a person
     off the street, robot faster than its own limit), None when it does not.
 
     The whole-scenario checks of a scenario file, shared with scenarios made on the
-    command line (record, closed-loop --cases) so that both accept the same values."""
+    command line (record, closed-loop --cases) so that both accept the same values.
+    `paths` name each person's path (default person_paths), `labels` each person
+    (default person_label)."""
     road = s.scene.road
     y_right, y_left = road.edges
     if s.robot.speed > s.robot.max_speed:
@@ -785,20 +1053,61 @@ def street_problem(s: Scenario) -> PlacementError | None:
             f"the robot would drive off the end of the road within the run "
             f"({end:.1f} m > {road.length / 2:.1f} m): lower the speed or the duration",
         )
+    paths = person_paths(s) if paths is None else paths
+    labels = [person_label(s, k) for k in range(len(s.people))] if labels is None else labels
     x0, x1, y0, y1 = street_bounds(road)
-    ped = pedestrian_path(s.pedestrian, s.duration, s.seed)
-    # Every vertex at once: a human walker's track has one every 10 ms.
-    times = np.array([0.0, *ped.breakpoints_between(0.0, s.duration), s.duration])
-    xy = ped.positions_at(times)
-    off = np.flatnonzero(
-        ~((x0 <= xy[:, 0]) & (xy[:, 0] <= x1) & (y0 <= xy[:, 1]) & (xy[:, 1] <= y1))
-    )
-    if len(off):
-        t, (x, y) = float(times[off[0]]), xy[off[0]]
-        return PlacementError(
-            "path",
-            {"t": round(t, 3), "x": round(float(x), 2), "y": round(float(y), 2)},
-            f"the pedestrian's path leaves the street (x in [{x0:g}, {x1:g}] m, "
-            f"y in [{y0:.2f}, {y1:.2f}] m)",
+    for k, person in enumerate(s.people):
+        ped = pedestrian_path(person, s.duration, s.seed)
+        # Every vertex at once: a human walker's track has one every 10 ms.
+        times = np.array([0.0, *ped.breakpoints_between(0.0, s.duration), s.duration])
+        xy = ped.positions_at(times)
+        off = np.flatnonzero(
+            ~((x0 <= xy[:, 0]) & (xy[:, 0] <= x1) & (y0 <= xy[:, 1]) & (xy[:, 1] <= y1))
         )
+        if len(off):
+            t, (x, y) = float(times[off[0]]), xy[off[0]]
+            whose = "the pedestrian's path" if len(s.people) == 1 else f"the path of {labels[k]}"
+            return PlacementError(
+                paths[k],
+                {"t": round(t, 3), "x": round(float(x), 2), "y": round(float(y), 2)},
+                f"{whose} leaves the street (x in [{x0:g}, {x1:g}] m, y in [{y0:.2f}, {y1:.2f}] m)",
+            )
     return None
+
+
+def _check_names(people: Sequence[PedestrianSpec], tables: Sequence[TomlTable]) -> None:
+    """Each person has a name of their own (the Scenario refuses two with one): the one
+    who wrote a name is blamed, the other named."""
+    seen: dict[str, int] = {}
+    for k, person in enumerate(people):
+        name = person_name(person, k)
+        if name in seen:
+            j = seen[name]
+            blamed, other = (k, j) if person.name else (j, k)
+            how = "" if people[other].name else f" (the name an unnamed person {other} gets)"
+            raise tables[blamed].error(
+                "name", name, f"person {other} is called {name!r} too{how}: each person needs "
+                "a name of their own",
+            )  # fmt: skip
+        seen[name] = k
+
+
+def _check_people(path: Path, s: Scenario, paths: Sequence[str], labels: Sequence[str]) -> None:
+    """Nobody starts inside another person, and nobody meets a parked car during the run."""
+    overlap = start_overlap(s)
+    if overlap is not None:
+        j, k = overlap
+        start = planned_path(s.people[k], s).state(0.0).position
+        raise StreetError(
+            path, paths[k], {"x": round(float(start[0]), 2), "y": round(float(start[1]), 2)},
+            f"{labels[k]} starts inside {labels[j]}: their footprints overlap at t = 0",
+        )  # fmt: skip
+    contact = parked_car_contact(s)
+    if contact is not None:
+        k = contact.person
+        x, y = contact.xy
+        raise StreetError(
+            path, paths[k], {"t": round(contact.t, 3), "x": round(x, 2), "y": round(y, 2)},
+            f"{labels[k]} walks into {parked_car_text(s.scene.occluders[contact.car])} (their "
+            "footprints meet): a person's path must go around the parked cars",
+        )  # fmt: skip
