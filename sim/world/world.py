@@ -65,7 +65,7 @@ def scenario_entities(scenario: Scenario, t_end: float) -> list[Entity]:
     cars, its lights, the robot and its people, the scripted one first (each walking
     `t_end` seconds ahead)."""
     people = [
-        PedestrianBody(p.looks, p, name=person_name(p, k), t_end=t_end)
+        PedestrianBody(p.looks, p, name=person_name(p, k), t_end=t_end, scripted=k == 0)
         for k, p in enumerate(scenario.people)
     ]
     return [

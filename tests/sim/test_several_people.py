@@ -24,6 +24,7 @@ from sim.scenario.spec import (
     Scenario,
     SceneSpec,
 )
+from sim.scenario.walkers import HumanWalker
 from sim.world.world import World
 from tests.rrd import column, rows_per_entity
 
@@ -143,3 +144,15 @@ def test_the_gymnasium_info_carries_every_persons_truth() -> None:
         assert len(info["truth"]["people"]) == 2
     finally:
         env.close()
+
+
+def test_human_bystanders_wander_each_their_own_way() -> None:
+    human = HumanWalker()
+    a = PedestrianSpec(x=6.0, y=3.0, heading_deg=0.0, speed=1.2, behaviour=human, name="a")
+    b = replace(a, y=-3.0, name="b")
+    with World(replace(scenario(a, b), duration=2.0), render=False) as world:
+        steps = list(world.run())
+    lateral = [[s.truth.people[k].position_world[1] for s in steps] for k in (1, 2)]
+    wander_a = np.array(lateral[0]) - 3.0
+    wander_b = np.array(lateral[1]) + 3.0
+    assert np.abs(wander_a).max() > 0.001 and not np.allclose(wander_a, wander_b)

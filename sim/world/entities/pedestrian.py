@@ -9,6 +9,7 @@ with `pose_at`.
 from __future__ import annotations
 
 import math
+import zlib
 from dataclasses import replace
 
 import mujoco
@@ -54,11 +55,13 @@ class PedestrianBody(Entity):
         *,
         name: str = "ped",
         t_end: float = 30.0,
+        scripted: bool = True,
     ) -> None:
         self.name = name
         self.looks = looks
         self.walk = walk
         self.t_end = t_end
+        self.scripted = scripted  # the person the run's warnings are judged against
         self.gait = Gait(height=looks.height)
         self.walker: Pedestrian | None = None
         # Where the body was last stood (the truth's placement, gait phase and speed).
@@ -82,10 +85,13 @@ class PedestrianBody(Entity):
     # -- motion -----------------------------------------------------------------------
 
     def reset(self, road: Road, rng: np.random.Generator, seed: int) -> None:
-        """The walk from its start; the run's seed draws a human walker's wander, its rng
-        the gait phase."""
+        """The walk from its start; its rng draws the gait phase, and the run's seed a human
+        walker's wander: the scripted person's from the seed itself (as with one person),
+        each other person's from the seed and their name, so no two wander alike."""
         if self.walk is None:
             raise RuntimeError(f"pedestrian {self.name!r} has no walk to start")
+        if not self.scripted:
+            seed = (seed + zlib.crc32(self.name.encode())) % 2**31
         self.walker = Pedestrian(road, self.walk, self.gait, t_end=self.t_end, seed=seed)
         self.walker.reset(gait_phase=float(rng.uniform()))
         road.objects.append(self.walker)
