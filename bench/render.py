@@ -35,6 +35,7 @@ ORDER = (
     "ncap_latency",
     "post_pose",
     "simulator",
+    "simulator_people",
     "found_share",
     "ground_replay",
     "suite_time",

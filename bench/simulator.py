@@ -10,7 +10,15 @@ spawned workers (1 and 2), with the peak RSS of a worker (ru_maxrss of the
 reaped children). The results go to bench/history.jsonl (bench/history.py) unless
 --no-append.
 
-    .venv/bin/python -m bench.simulator [--frames 60] [--runs 6] [--no-append]
+Then, as a line of its own in the history (benchmark `simulator_people`), the frame with
+1, 5, 10 and 20 people in view (PEOPLE): World.step with rendering at 768x432 on one core,
+split into the render (and its shadow pass: the same crowd under the overcast preset, which
+has no shadow pass, rendered alongside), the truth (World's per-frame ground truth of every
+body) and, within the truth, the hidden share: `visibility()` (one mj_multiRay per person)
+and `occluded_landmarks` (33 mj_ray calls per person), each timed by a perf_counter wrapped
+around it in the child (`timed_parts`). `--people-only` runs that part alone.
+
+    .venv/bin/python -m bench.simulator [--frames 60] [--runs 6] [--people-only] [--no-append]
 """
 
 from __future__ import annotations
@@ -23,7 +31,10 @@ import statistics
 import subprocess
 import sys
 import time
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import ExitStack, contextmanager
 from typing import Any
+from unittest import mock
 
 from bench.history import ROOT
 from bench.recorder import Recorder
@@ -32,6 +43,37 @@ REALTIME_FPS = 15.0
 CASES = (1, 2, 3, 4, 5, 6, 8)  # walking cases; still (9) has no motion to predict
 RUN_CASES = (5, 3, 5, 3)  # the whole-run rows: two cases twice, so one noisy run moves no median
 TITLE = "Simulator: render time, scenario run on one core, sweep throughput"
+PEOPLE_TITLE = "Simulator: render and truth per frame with 1 to 20 people in view"
+PEOPLE = (1, 5, 10, 20)  # people in view: the scripted person and PEOPLE - 1 bystanders
+PEOPLE_STRETCH_X = 0.6  # the stretch goal: 10 people's frame rate over 1 person's
+WARM_STEPS = 2  # steps of each world not timed (the new scene's first draws)
+# The bystanders in the order they join (x, y, heading in degrees, speed in m/s), in the world
+# frame: the robot starts at the origin heading east (+x) at 2 m/s, the road is along x
+# with its edges at y = -3.5 and 3.5 and a 3 m pavement beyond each. Walkers in a row keep
+# one direction and speed, so none meets another; all are at x >= 13, clear of the
+# scripted person crossing at x = 8, and within the camera's view (half-angle 48 degrees)
+# while the robot covers its first 8 m (60 frames).
+BYSTANDERS: tuple[tuple[float, float, float, float], ...] = (
+    (14.0, 4.6, 0.0, 1.3),  # north pavement, walking east
+    (18.0, -4.6, 180.0, 1.2),  # south pavement, walking west
+    (17.0, 6.0, -90.0, 0.0),  # north pavement by the facades, standing
+    (15.0, -6.0, 90.0, 0.0),  # south pavement by the facades, standing
+    (24.0, 2.7, 180.0, 1.4),  # along the road, north lane by the kerb, walking west
+    (16.0, -2.7, 0.0, 1.1),  # along the road, south lane by the kerb, walking east
+    (22.0, 4.6, 0.0, 1.3),
+    (26.0, -4.6, 180.0, 1.2),
+    (25.0, 6.0, -90.0, 0.0),
+    (23.0, -6.0, 90.0, 0.0),
+    (20.0, -3.7, 90.0, 0.0),  # at the south kerb, facing the road
+    (33.0, 6.0, -90.0, 0.0),
+    (31.0, -6.0, 90.0, 0.0),
+    (30.0, 4.6, 0.0, 1.3),
+    (34.0, -4.6, 180.0, 1.2),
+    (36.0, 2.7, 180.0, 1.4),
+    (28.0, -2.7, 0.0, 1.1),
+    (41.0, 6.0, -90.0, 0.0),
+    (39.0, -6.0, 90.0, 0.0),
+)
 
 
 def scenario(
@@ -56,6 +98,212 @@ def scenario(
     sun = sc.scene.lighting.sun  # the same sun behind clouds
     overcast = PRESETS["overcast"].with_sun(sun.azimuth_deg, sun.elevation_deg)
     return replace(sc, scene=replace(sc.scene, lighting=overcast))
+
+
+def crowd(people: int, frames: int, shadows: bool = True) -> Any:
+    """`scenario(5, frames, shadows=shadows)` (the scripted person crossing 8 m ahead) with the
+    first `people - 1` BYSTANDERS, named b1, b2, ..."""
+    from dataclasses import replace
+
+    from sim.scenario.spec import PedestrianSpec
+
+    if not 1 <= people <= len(BYSTANDERS) + 1:
+        raise ValueError(f"people must be 1 to {len(BYSTANDERS) + 1}, got {people}")
+    others = tuple(
+        PedestrianSpec(x, y, heading, speed, name=f"b{k}")
+        for k, (x, y, heading, speed) in enumerate(BYSTANDERS[: people - 1], start=1)
+    )
+    return replace(scenario(5, frames, shadows=shadows), bystanders=others)
+
+
+class Stopwatch:
+    """Seconds spent in the calls of the functions it wraps, since the last `reset`."""
+
+    def __init__(self) -> None:
+        self.s = 0.0
+
+    def reset(self) -> None:
+        self.s = 0.0
+
+    def wrap(self, fn: Callable[..., Any]) -> Callable[..., Any]:
+        def timed(*args: Any, **kwargs: Any) -> Any:
+            t0 = time.perf_counter()
+            try:
+                return fn(*args, **kwargs)
+            finally:
+                self.s += time.perf_counter() - t0
+
+        return timed
+
+
+PARTS = ("render", "truth", "visibility", "landmark_rays")
+
+
+@contextmanager
+def timed_parts() -> Iterator[dict[str, Stopwatch]]:
+    """A Stopwatch per part of World.step, wrapped around (and, on leaving, unwrapped from):
+    World.render (the frame), World._ground_truth (every body's truth), and the two
+    hidden-share functions as sim.world.entities.pedestrian calls them (`visibility`,
+    `occluded_landmarks`). A wrapper costs about a microsecond a call."""
+    from sim.world import world as world_module
+    from sim.world.entities import pedestrian as pedestrian_module
+
+    watches = {part: Stopwatch() for part in PARTS}
+    targets = (
+        (world_module.World, "render", "render"),
+        (world_module.World, "_ground_truth", "truth"),
+        (pedestrian_module, "visibility", "visibility"),
+        (pedestrian_module, "occluded_landmarks", "landmark_rays"),
+    )
+    with ExitStack() as stack:
+        for owner, attr, part in targets:
+            wrapped = watches[part].wrap(getattr(owner, attr))
+            stack.enter_context(mock.patch.object(owner, attr, wrapped))
+        yield watches
+
+
+def child_people(frames: int, counts: Sequence[int] = PEOPLE, rounds: int = 2) -> dict[str, Any]:
+    """World.step with rendering at 768x432 for each crowd of `counts` people, under the
+    scenario's sun and overcast (no shadow pass), timed by part (timed_parts); p50 per frame.
+
+    Rounds alternate the order (counts up then down, sun then overcast and back), so the
+    host's drift hits every setting alike; the worlds share one GL context, and each
+    world's first WARM_STEPS steps are not timed.
+    """
+    import numpy as np
+
+    from sim.world.render import KeptRenderContext
+    from sim.world.world import World
+
+    if frames <= WARM_STEPS + 1:
+        raise ValueError(f"frames must be more than {WARM_STEPS + 1}, got {frames}")
+    keys = ("step", *PARTS, "in_frame", "seen")
+    got: dict[tuple[int, bool], dict[str, list[float]]] = {
+        (n, sh): {k: [] for k in keys} for n in counts for sh in (True, False)
+    }
+    with KeptRenderContext() as kept, timed_parts() as watches:
+        context = kept.fitting(768, 432)
+        for r in range(rounds):
+            order = list(counts) if r % 2 == 0 else list(counts)[::-1]
+            lights = (True, False) if r % 2 == 0 else (False, True)
+            for n in order:
+                for shadows in lights:
+                    out = got[(n, shadows)]
+                    with World(crowd(n, frames, shadows), render_context=context) as world:
+                        world.reset()
+                        for k in range(frames - 1):  # as World.run: reset, then frames - 1
+                            for watch in watches.values():
+                                watch.reset()
+                            t0 = time.perf_counter()
+                            step = world.step()
+                            wall = time.perf_counter() - t0
+                            if k < WARM_STEPS:
+                                continue
+                            out["step"].append(1e3 * wall)
+                            for part, watch in watches.items():
+                                out[part].append(1e3 * watch.s)
+                            people = step.truth.people
+                            out["in_frame"].append(sum(p.body.in_frame for p in people))
+                            out["seen"].append(
+                                float(np.mean([p.visibility.visible for p in people]))
+                            )
+    res: dict[str, Any] = {}
+    for (n, shadows), out in got.items():
+        row: dict[str, Any] = {
+            f"{k}_p50_ms": float(np.percentile(out[k], 50)) for k in ("step", *PARTS)
+        }
+        row["step_p95_ms"] = float(np.percentile(out["step"], 95))
+        rest = np.array(out["step"]) - np.array(out["render"]) - np.array(out["truth"])
+        row["rest_p50_ms"] = float(np.percentile(rest, 50))
+        row["frames"] = len(out["step"])
+        row["in_frame_min"] = int(min(out["in_frame"]))
+        row["seen_mean"] = float(np.mean(out["seen"]))
+        res.setdefault(str(n), {})["sun" if shadows else "overcast"] = row
+    res["rounds"] = rounds
+    res["maxrss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return res
+
+
+def people_report(people: dict[str, Any], frames: int) -> tuple[dict[str, Any], str]:
+    """The people child's figures as history results and a Markdown table."""
+    counts = sorted(int(k) for k in people if k.isdigit())
+    fps = {n: 1e3 / people[str(n)]["sun"]["step_p50_ms"] for n in counts}
+    lines = [
+        f"Scenario: sim.scenario.cases.CasePlacement case 5 at 8 m (robot 2 m/s), with "
+        f"bystanders standing and walking on the pavements and along the road "
+        f"(bench/simulator.py BYSTANDERS); World.step with rendering at 768x432 on one core, "
+        f"{frames - 1 - WARM_STEPS} timed steps per world, {people['rounds']} rounds; p50 per "
+        "frame of each part (the parts' p50s need not add up to the frame's). Shadow pass: the "
+        "render under the scenario's sun less the render of the same crowd overcast (no shadow "
+        "pass). Hidden share: visibility() (one mj_multiRay per person) and occluded_landmarks "
+        "(33 mj_ray calls per person), both within the truth.",
+        "",
+        "| people (in frame at least; mean share seen) | frame p50 | fps | vs 1 person | render "
+        "| of which shadow pass | truth | hidden share: visibility() "
+        "| hidden share: landmark rays | rest (motion, posing) | frame overcast |",
+        "| --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    rows = []
+    for n in counts:
+        sun, cloud = people[str(n)]["sun"], people[str(n)]["overcast"]
+        shadow = sun["render_p50_ms"] - cloud["render_p50_ms"]
+        vs_one = fps[n] / fps[counts[0]]
+        rows.append(
+            {
+                "people": n,
+                "in_frame_min": sun["in_frame_min"],
+                "seen_mean": sun["seen_mean"],
+                "frames": sun["frames"],
+                "frame_p50_ms": sun["step_p50_ms"],
+                "frame_p95_ms": sun["step_p95_ms"],
+                "fps": fps[n],
+                "vs_one_x": vs_one,
+                "render_p50_ms": sun["render_p50_ms"],
+                "shadow_pass_ms": shadow,
+                "truth_p50_ms": sun["truth_p50_ms"],
+                "visibility_p50_ms": sun["visibility_p50_ms"],
+                "landmark_rays_p50_ms": sun["landmark_rays_p50_ms"],
+                "rest_p50_ms": sun["rest_p50_ms"],
+                "overcast_frame_p50_ms": cloud["step_p50_ms"],
+                "overcast_render_p50_ms": cloud["render_p50_ms"],
+                "overcast_truth_p50_ms": cloud["truth_p50_ms"],
+            }
+        )
+        lines.append(
+            f"| {n} ({sun['in_frame_min']}; {sun['seen_mean']:.2f}) | {sun['step_p50_ms']:.1f} ms "
+            f"| {fps[n]:.1f} | {vs_one:.2f}x | {sun['render_p50_ms']:.1f} ms | {shadow:.1f} ms "
+            f"| {sun['truth_p50_ms']:.1f} ms | {sun['visibility_p50_ms']:.1f} ms "
+            f"| {sun['landmark_rays_p50_ms']:.1f} ms | {sun['rest_p50_ms']:.1f} ms "
+            f"| {cloud['step_p50_ms']:.1f} ms |"
+        )
+    results: dict[str, Any] = {
+        "frames_per_world": frames,
+        "rounds": people["rounds"],
+        "rows": rows,
+        "stretch_goal_x": PEOPLE_STRETCH_X,
+        "peak_rss_mb": people["maxrss_mb"],
+    }
+    if 1 in fps and 10 in fps:
+        ratio = fps[10] / fps[1]
+        cloudy = people["1"]["overcast"]["step_p50_ms"] / people["10"]["overcast"]["step_p50_ms"]
+        results["fps_10_over_1_x"] = ratio
+        results["overcast_fps_10_over_1_x"] = cloudy
+        lines += [
+            "",
+            f"10 people's frame rate over 1 person's: {ratio:.2f} (stretch goal "
+            f"{PEOPLE_STRETCH_X:g}: {'met' if ratio >= PEOPLE_STRETCH_X else 'not met'}); "
+            f"overcast (no shadow pass) {cloudy:.2f}.",
+        ]
+    top = rows[-1]
+    hidden = top["visibility_p50_ms"] + top["landmark_rays_p50_ms"]
+    lines += [
+        "",
+        f"At {top['people']} people the hidden share takes {hidden:.1f} ms a frame "
+        f"({hidden / top['truth_p50_ms']:.0%} of the truth, "
+        f"{hidden / top['frame_p50_ms']:.0%} of the frame); the render "
+        f"{top['render_p50_ms'] / top['frame_p50_ms']:.0%} of the frame.",
+    ]
+    return results, "\n".join(lines)
 
 
 def child_render(frames: int) -> dict[str, Any]:
@@ -166,7 +414,13 @@ def main() -> None:
     ap.add_argument("--frames", type=int, default=60, help="frames per scenario run (15 fps)")
     ap.add_argument("--runs", type=int, default=6, help="runs per sweep throughput test")
     ap.add_argument("--no-append", action="store_true", help="do not write the history")
-    ap.add_argument("--child", choices=("render", "run", "sweep"), help=argparse.SUPPRESS)
+    ap.add_argument(
+        "--people-only", action="store_true",
+        help="only the frame with 1 to 20 people in view (its own history line)",
+    )  # fmt: skip
+    ap.add_argument("--child", choices=("render", "run", "sweep", "people"), help=argparse.SUPPRESS)
+    ap.add_argument("--people", type=int, nargs="+", default=PEOPLE, help=argparse.SUPPRESS)
+    ap.add_argument("--rounds", type=int, default=2, help=argparse.SUPPRESS)
     ap.add_argument("--pin", action="store_true", help=argparse.SUPPRESS)
     ap.add_argument("--ablation", type=int, default=0, help=argparse.SUPPRESS)
     ap.add_argument("--shadows", type=int, default=1, help=argparse.SUPPRESS)
@@ -179,6 +433,8 @@ def main() -> None:
             os.sched_setaffinity(0, sorted(os.sched_getaffinity(0))[:1])
         if args.child == "render":
             out = child_render(args.frames)
+        elif args.child == "people":
+            out = child_people(args.frames, args.people, args.rounds)
         elif args.child == "run":
             out = child_run(
                 args.frames, bool(args.ablation), bool(args.shadows), args.model, args.runtime
@@ -188,6 +444,17 @@ def main() -> None:
         print(json.dumps(out))
         return
 
+    if not args.people_only:
+        main_rows(args)
+    recorder = Recorder("simulator_people", PEOPLE_TITLE)
+    people = spawn_child("people", True, frames=args.frames)
+    results, table = people_report(people, args.frames)
+    print(table)
+    recorder.finish(results, table, write=not args.no_append)
+
+
+def main_rows(args: argparse.Namespace) -> None:
+    """The render, whole-run and sweep rows: the `simulator` line of the history."""
     recorder = Recorder("simulator", TITLE)
     load0 = os.getloadavg()[0]
     start = time.perf_counter()
