@@ -119,6 +119,52 @@ class Visibility:
         }
 
 
+HIDDEN_GROUP = 5  # a geom group no ray test here sees (first_hits parks the others in it)
+
+
+def first_hits(
+    model: mujoco.MjModel, data: mujoco.MjData, origin: np.ndarray, points: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """The first geom the camera draws on each line from `origin` to a point, and how far
+    along it (-1 and -1: none): one mj_multiRay.
+
+    MuJoCo tests every ray against every geom, so with many people the cost grows with the
+    square of the crowd. Only geoms whose bounding sphere reaches into the cone around the
+    lines (and no farther than the farthest point) can be hit; the others are moved to a
+    group the test does not see for the call and put back after, so the answer is the one
+    the whole scene gives (bench.simulator's people rows measure it)."""
+    origin = np.asarray(origin, dtype=float)
+    rays = np.asarray(points, dtype=float) - origin
+    n = len(rays)
+    hit_geom = np.full(n, -1, dtype=np.int32)
+    hit_dist = np.full(n, -1.0)
+    if n == 0:
+        return hit_geom, hit_dist
+    dist = np.linalg.norm(rays, axis=1)
+    unit = rays / np.maximum(dist, 1e-9)[:, None]
+    axis = unit.mean(axis=0)
+    axis /= max(float(np.linalg.norm(axis)), 1e-12)
+    spread = float(np.arccos(np.clip(unit @ axis, -1.0, 1.0)).max())
+    centres = data.geom_xpos - origin
+    reach = np.linalg.norm(centres, axis=1)
+    radius = model.geom_rbound
+    inside = reach <= radius
+    sphere = np.arcsin(np.clip(radius / np.maximum(reach, 1e-12), 0.0, 1.0))
+    off_axis = np.arccos(np.clip((centres @ axis) / np.maximum(reach, 1e-12), -1.0, 1.0))
+    near = off_axis <= spread + sphere + 1e-6
+    candidate = (radius <= 0) | inside | (near & (reach - radius <= float(dist.max()) + 1e-6))
+    groups = model.geom_group.copy()
+    try:
+        model.geom_group[~candidate] = HIDDEN_GROUP
+        mujoco.mj_multiRay(
+            model, data, origin, unit.reshape(-1), VISIBLE_GEOM_GROUPS, 1, -1, hit_geom,
+            hit_dist, None, n, float(dist.max()) + 1.0,
+        )  # fmt: skip
+    finally:
+        model.geom_group[:] = groups
+    return hit_geom, hit_dist
+
+
 def visibility(
     model: mujoco.MjModel,
     data: mujoco.MjData,
@@ -131,23 +177,14 @@ def visibility(
 ) -> Visibility:
     """The Visibility of a body whose surface points are `points_world` (N, 3).
 
-    One MuJoCo ray per point from the camera (mj_multiRay over the geoms the camera
+    One MuJoCo ray per point from the camera (first_hits, over the geoms the camera
     draws); the first geom hit decides: another body's (by its kind, `geom_kind[geom]`
     an index into HIDERS), or the body's own or nothing (seen, if inside the image)."""
     px = camera.project(robot.to_local(points_world))
     with np.errstate(invalid="ignore"):
         inside = in_image(camera, px)
-    rays = np.asarray(points_world, dtype=float) - camera_world
-    dist = np.linalg.norm(rays, axis=1)
-    n = len(rays)
-    hit_geom = np.full(n, -1, dtype=np.int32)
-    hit_dist = np.full(n, -1.0)
-    if n:
-        unit = (rays / np.maximum(dist, 1e-9)[:, None]).reshape(-1)
-        mujoco.mj_multiRay(
-            model, data, np.asarray(camera_world, dtype=float), unit, VISIBLE_GEOM_GROUPS, 1,
-            -1, hit_geom, hit_dist, None, n, float(dist.max()) + 1.0,
-        )  # fmt: skip
+    dist = np.linalg.norm(np.asarray(points_world, dtype=float) - camera_world, axis=1)
+    hit_geom, hit_dist = first_hits(model, data, camera_world, points_world)
     blocked = (hit_dist >= 0) & (hit_dist < dist - OCCLUSION_TOLERANCE)
     blocked &= ~np.isin(hit_geom, own_geoms)
     kinds = np.where(blocked, geom_kind[np.clip(hit_geom, 0, None)], -1)

@@ -6,6 +6,7 @@ import json
 from dataclasses import replace
 
 import gymnasium as gym
+import mujoco
 import numpy as np
 import pytest
 
@@ -25,6 +26,7 @@ from sim.scenario.spec import (
     SceneSpec,
 )
 from sim.scenario.walkers import HumanWalker
+from sim.world.ground_truth import VISIBLE_GEOM_GROUPS, first_hits
 from sim.world.world import World
 from tests.rrd import column, rows_per_entity
 
@@ -156,3 +158,31 @@ def test_human_bystanders_wander_each_their_own_way() -> None:
     wander_a = np.array(lateral[0]) - 3.0
     wander_b = np.array(lateral[1]) + 3.0
     assert np.abs(wander_a).max() > 0.001 and not np.allclose(wander_a, wander_b)
+
+
+def test_lines_of_sight_tested_against_nearby_geoms_only_give_the_whole_scenes_answer() -> None:
+    """first_hits leaves out the geoms that cannot be in the way; the hits are those of one
+    mj_multiRay over every geom, for every person of a street with twelve."""
+    bystanders = tuple(
+        PedestrianSpec(x=4.0 + 1.5 * k, y=(-1) ** k * (0.6 + 0.4 * k), heading_deg=30.0 * k,
+                       speed=0.0, name=f"b{k}")
+        for k in range(11)
+    )  # fmt: skip
+    with World(scenario(*bystanders), render=False) as world:
+        world.reset()
+        model, data = world.scene.model, world.scene.data
+        origin = world.robot_body.camera_world(data)
+        for person in world.scene.pedestrians:
+            points = person.sight_shapes.surface_points(data)
+            geom, dist = first_hits(model, data, origin, points)
+            rays = points - origin
+            length = np.linalg.norm(rays, axis=1)
+            whole_geom = np.full(len(points), -1, dtype=np.int32)
+            whole_dist = np.full(len(points), -1.0)
+            mujoco.mj_multiRay(
+                model, data, origin, (rays / length[:, None]).reshape(-1),
+                VISIBLE_GEOM_GROUPS, 1, -1, whole_geom, whole_dist, None, len(points),
+                float(length.max()) + 1.0,
+            )  # fmt: skip
+            assert np.array_equal(geom, whole_geom) and np.array_equal(dist, whole_dist)
+        assert (model.geom_group <= 3).all()  # every geom back in its own group
