@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from sim.analysis.people import person_at, summarise_people, warned_people
+from sim.analysis.report import people_lines
 from sim.runs.result import (
     CameraSummary,
     DecisionColumns,
@@ -74,3 +75,13 @@ def test_a_near_miss_warned_for_a_bystander_is_a_wrong_person_warning() -> None:
     people = [person("a", FAR_BOX, [0] * 3, [None] * 3), person("b", NEAR_BOX, [0] * 3, [None] * 3)]
     s = summarise_people([run([0, 1, 0], [None, [180.0, 190.0], None], people)], "rules/image")
     assert (s.near_misses, s.near_misses_warned, s.wrong_person) == (1, 1, 1)
+
+
+def test_the_sweep_report_says_whose_warning_only_with_several_people() -> None:
+    feet = [None, [180.0, 190.0], [120.0, 140.0], [180.0, 190.0], None]
+    lines = people_lines([run([0, 1, 1, 1, 1], feet)], ["rules/image"])
+    assert lines[0] == "## Several people: whose warning"
+    row = next(line for line in lines if line.startswith("| f "))
+    cells = [c.strip() for c in row.strip("|").split("|")]
+    assert cells[3:7] == ["1/1", "-", "67 % (2/3)", "1"]
+    assert people_lines([run([1] * 5, [None] * 5, people=[])], ["rules/image"]) == []
