@@ -16,6 +16,7 @@ from typing import Any
 
 from sim.runs.sweep import SweepSpec, expand_spec
 from sim.runs.sweep import parse_spec as parse_sweep_spec
+from sim.scenario.files import PEOPLE_KEY, people_files
 from sim.scenario.spec import Scenario
 from sim.scenario.toml_table import FieldError, read_toml
 
@@ -68,14 +69,24 @@ def load_spec(path: Path) -> DatasetSpec:
 
 
 def _scenario_files(sweep: SweepSpec) -> tuple[tuple[str, str], ...]:
-    """The scenario files a sweep spec includes, named by their path from the spec's folder
-    (leading ../ dropped), with their text: copied into the dataset, part of its digest."""
+    """The scenario files a sweep spec includes and the people files they and the includes
+    name, by their path from the spec's folder (leading ../ dropped), with their text:
+    copied into the dataset, part of its digest."""
     out: dict[str, str] = {}
+
+    def add(file: Path) -> None:
+        rel = Path(os.path.relpath(file, sweep.path.parent))
+        name = "/".join(part for part in rel.parts if part not in ("..", "."))
+        out[name] = file.read_text(encoding="utf-8")
+
     for include in sweep.includes:
         for file in include.files:
-            rel = Path(os.path.relpath(file, sweep.path.parent))
-            name = "/".join(part for part in rel.parts if part not in ("..", "."))
-            out[name] = file.read_text(encoding="utf-8")
+            add(file)
+            _, data = read_toml(file, "scenario file")
+            for people in people_files(file, data.get(PEOPLE_KEY, "")):
+                add(people)  # the file's own bystanders
+        for people in include.people:  # those the include adds
+            add(people)
     return tuple(out.items())
 
 

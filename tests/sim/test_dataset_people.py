@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import configparser
 import json
+import shutil
 from collections import defaultdict
 from collections.abc import Sequence
 from pathlib import Path
@@ -31,6 +32,7 @@ from sim.scenario.spec import (
     Scenario,
     SceneSpec,
 )
+from tests.paths import ROOT
 from tests.sim.test_dataset import assert_pycocotools_reads_what_our_reader_reads, write_spec
 
 WIDTH, HEIGHT = 320, 180
@@ -216,3 +218,22 @@ def test_a_run_without_its_mot_sequence_is_rendered_again(tmp_path: Path) -> Non
     (tmp_path / "mot" / run.id / "gt").mkdir(parents=True)
     (tmp_path / "mot" / run.id / "gt" / "gt.txt").write_text("")
     assert finished_runs(tmp_path, [run]) == {run.id: record}
+
+
+def test_a_dataset_keeps_the_people_files_its_runs_are_made_from(tmp_path: Path) -> None:
+    folder = tmp_path / "specs"
+    (folder / "people").mkdir(parents=True)
+    shutil.copy(ROOT / "scenarios/families/small/cpna25.toml", folder / "cpna25.toml")
+    shutil.copy(ROOT / "scenarios/people/pavement_pair.toml", folder / "people/pair.toml")
+    spec = folder / "d.toml"
+    spec.write_text(
+        'name = "d"\ndescription = "x"\n[[include]]\nfiles = ["cpna25.toml"]\n'
+        'people = "people/pair.toml"\n'
+    )
+    names = dict(load_spec(spec).scenario_files)
+    assert set(names) == {"cpna25.toml", "people/pair.toml"}
+    before = load_spec(spec).digest
+    (folder / "people/pair.toml").write_text(
+        (folder / "people/pair.toml").read_text().replace("2.4", "2.5", 1)
+    )
+    assert load_spec(spec).digest != before  # a changed people file is another dataset
