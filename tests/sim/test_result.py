@@ -13,6 +13,7 @@ from sim.runs.result import (
     CameraSummary,
     DecisionColumns,
     Machine,
+    PersonColumns,
     PipelineColumns,
     ResultError,
     RunResult,
@@ -79,6 +80,19 @@ def every_field_set() -> RunResult:
             ms={"main": {"total": [12.0, None, 11.0]}},
             machine=Machine(host="vm", cpu="AMD EPYC", cores=2),
         ),  # fmt: skip
+        people=[
+            PersonColumns(
+                name=name,
+                scripted=name == "ped",
+                **{
+                    f.name: [1, None, 0] if f.type == "list[int]" else [0.5, None, [1.0, 2.0]]
+                    for f in dataclasses.fields(PersonColumns)
+                    if f.name not in ("name", "scripted")
+                },
+            )
+            for name in ("ped", "b1")
+        ],
+        first_threat="b1",
     )
 
 
@@ -105,7 +119,9 @@ def test_a_written_line_reads_back_with_every_field_equal(tmp_path: Path) -> Non
 
 def test_lines_keep_their_key_order_and_deterministic_drops_only_timing() -> None:
     record = every_field_set()
-    assert list(record.to_json()) == list(RunResult.ORDER)
+    assert list(record.to_json()) == [*RunResult.ORDER, *RunResult.OPTIONAL]
+    alone = dataclasses.replace(record, people=[], first_threat=None)  # one person
+    assert list(alone.to_json()) == list(RunResult.ORDER)
     assert set(record.to_json()) - set(record.deterministic()) == {"timing"}
 
 
