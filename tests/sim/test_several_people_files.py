@@ -17,6 +17,7 @@ from sim.scenario.path import pedestrian_path
 from sim.world.world import World
 from tests.paths import SCENARIOS
 from tests.sim.test_presets import keyed, readme_tables
+from tests.sim.test_scenario_file import error_of, write
 
 # The scripted person crosses from the nearside 6 m ahead of a standing small robot.
 SCRIPTED = """
@@ -53,18 +54,6 @@ x = 10.0
 direction = "toward"
 """
 PAIR = SCENARIOS / "people" / "pavement_pair.toml"
-
-
-def write(tmp_path: Path, text: str, name: str = "s.toml") -> Path:
-    path = tmp_path / name
-    path.write_text(text)
-    return path
-
-
-def error_of(path: Path) -> ScenarioFileError:
-    with pytest.raises(ScenarioFileError) as info:
-        load(path)
-    return info.value
 
 
 def test_a_pedestrian_table_and_the_same_person_listed_build_equal_scenarios(
