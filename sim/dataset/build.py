@@ -196,17 +196,19 @@ class FrameWriter(Listener):
                 "mask_file": mask_name(run.id, k, 1),
             }
         )
+        masks = self.world.person_masks()
         for track_id, person in enumerate(truth.people, start=1):
-            self._person(image_id, k, track_id, person)
+            self._person(image_id, k, track_id, person, masks[person.name])
         self.truth_lines.append(_truth_line(run, k, image_name, mask_name(run.id, k, 1), truth))
 
-    def _person(self, image_id: int, k: int, track_id: int, person: PersonTruth) -> None:
+    def _person(
+        self, image_id: int, k: int, track_id: int, person: PersonTruth, mask: np.ndarray
+    ) -> None:
         """One person's mask, COCO annotation (if any pixel shows) and gt.txt line (if in
         the image)."""
         assert self.world is not None
         cam = self.run.scenario.robot.camera
         name = mask_name(self.run.id, k, track_id)
-        mask = self.world.person_mask(person.name)
         cv2.imwrite(str(self.out / name), mask.astype(np.uint8) * 255)
         area = int(mask.sum())
         if area > 0:

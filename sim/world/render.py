@@ -16,6 +16,7 @@ import os
 
 os.environ.setdefault("MUJOCO_GL", "egl")
 
+from collections.abc import Sequence  # noqa: E402
 from dataclasses import dataclass  # noqa: E402
 from typing import Any  # noqa: E402
 
@@ -196,20 +197,28 @@ class SceneRenderer(Closing):
 
     def mask(self, geoms: np.ndarray) -> np.ndarray:
         """Boolean (height, width) mask of the pixels where any of `geoms` is visible
-        (a body's geoms: Scene.geoms_of).
+        (a body's geoms: Scene.geoms_of)."""
+        return self.masks([geoms])[0]
+
+    def masks(self, bodies: Sequence[np.ndarray]) -> list[np.ndarray]:
+        """One boolean (height, width) mask per body (its geoms), from one render.
 
         Uses MuJoCo's segmentation rendering (each drawn geom in its own colour), so
-        occluders hide the body as they do in the colour image.
+        occluders hide a body as they do in the colour image.
         """
         image = self._draw((), segmentation=True).astype(np.int64)
         segid = image[..., 0] + (image[..., 1] << 8) + (image[..., 2] << 16)  # 0: none
-        lookup = np.zeros(self._scene.ngeom + 1, dtype=bool)
-        wanted = set(np.asarray(geoms).tolist())
+        segid = np.clip(segid, 0, self._scene.ngeom)
+        owner = np.full(self.scene.model.ngeom, -1)  # geom id -> body index
+        for b, geoms in enumerate(bodies):
+            owner[np.asarray(geoms, dtype=int)] = b
+        lookup = np.full(self._scene.ngeom + 1, -1)  # segmentation id + 1 -> body index
         for k in range(self._scene.ngeom):
             g = self._scene.geoms[k]
-            if g.segid >= 0 and g.objtype == mujoco.mjtObj.mjOBJ_GEOM and g.objid in wanted:
-                lookup[g.segid + 1] = True
-        return lookup[np.clip(segid, 0, self._scene.ngeom)]
+            if g.segid >= 0 and g.objtype == mujoco.mjtObj.mjOBJ_GEOM:
+                lookup[g.segid + 1] = owner[g.objid]
+        body_of = lookup[segid]
+        return [body_of == b for b in range(len(bodies))]
 
     def close(self) -> None:
         """Free the GL resources; the renderer cannot be used afterwards."""

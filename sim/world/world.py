@@ -182,28 +182,28 @@ class World(Closing):
 
     # -- rendering --------------------------------------------------------------------
 
-    def render(self, markers: tuple[Marker, ...] = ()) -> np.ndarray:
-        """The robot camera's image of the current state (RGB uint8), e.g. with test markers."""
+    @property
+    def renderer(self) -> SceneRenderer:
+        """The robot camera's renderer, made on first use (sim.world.render says why)."""
         if self._renderer is None:
             self._renderer = SceneRenderer(self.scene, context=self.render_context)
-        return self._renderer.render(markers)
+        return self._renderer
+
+    def render(self, markers: tuple[Marker, ...] = ()) -> np.ndarray:
+        """The robot camera's image of the current state (RGB uint8), e.g. with test markers."""
+        return self.renderer.render(markers)
 
     def pedestrian_mask(self) -> np.ndarray:
         """Pixels where the scenario's pedestrian is visible in the current image (bool, H x W)."""
-        if self._renderer is None:
-            self._renderer = SceneRenderer(self.scene, context=self.render_context)
-        return self._renderer.mask(self.scene.geoms_of(self.scene.pedestrians[0]))
+        return self.renderer.mask(self.scene.geoms_of(self.scene.pedestrians[0]))
 
-    def person_mask(self, name: str) -> np.ndarray:
-        """Pixels where the person `name` (PersonTruth.name) is visible in the current image
-        (bool, H x W); other people and objects hide them as in the image."""
-        body = next((p for p in self.scene.pedestrians if p.name == name), None)
-        if body is None:
-            names = [p.name for p in self.scene.pedestrians]
-            raise KeyError(f"no person named {name!r} in the scene (people: {names})")
-        if self._renderer is None:
-            self._renderer = SceneRenderer(self.scene, context=self.render_context)
-        return self._renderer.mask(self.scene.geoms_of(body))
+    def person_masks(self) -> dict[str, np.ndarray]:
+        """Every person's visible pixels in the current image (bool, H x W) by their name
+        (PersonTruth.name), from one segmentation render; other people and objects hide
+        them as in the image."""
+        people = self.scene.pedestrians
+        masks = self.renderer.masks([self.scene.geoms_of(p) for p in people])
+        return {p.name: mask for p, mask in zip(people, masks, strict=True)}
 
     def close(self) -> None:
         if self._renderer is not None:

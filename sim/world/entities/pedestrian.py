@@ -251,7 +251,3 @@ class PedestrianBody(Entity):
             footprint_world=footprint,
             visibility=seen,
         )
-
-    def mask_geoms(self) -> frozenset[int]:
-        """The geoms a segmentation mask of this person counts."""
-        return frozenset(int(g) for g in self.mannequin.geom_ids)
