@@ -230,9 +230,14 @@ def run_case(row: RunResult) -> int:
 
 def contact_time(row: RunResult) -> float | None:
     """First contact by the truth: where frames on a collision course say it will happen."""
-    truth = row.truth
-    times = [t + c for t, c in zip(truth.t, truth.ttc, strict=True) if c is not None]
-    return min(times) if times else None
+    return earliest_contact(row.truth.t, row.truth.ttc)
+
+
+def earliest_contact(times: Sequence[float | None], ttcs: Sequence[float | None]) -> float | None:
+    """The earliest frame time plus its time to collision (None: no frame has one)."""
+    ends = [float(t) + float(c) for t, c in zip(times, ttcs, strict=True)
+            if c is not None and t is not None]  # fmt: skip
+    return min(ends) if ends else None
 
 
 def frame_latency_ms(row: RunResult, pipeline: str, k: int) -> float | None:

@@ -20,7 +20,7 @@ import math
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from sim.analysis.metrics import LEAD_GOAL, split_method
+from sim.analysis.metrics import LEAD_GOAL, earliest_contact, split_method
 from sim.runs.result import PersonColumns, RunResult
 
 
@@ -122,11 +122,6 @@ def _first_contact(row: RunResult) -> float | None:
     """When the first threat's footprint meets the robot's, by the truth (as
     sim.analysis.metrics.contact_time says it for the scripted person): the earliest frame
     time plus time to collision over the people who are ever on a collision course."""
-    times = [
-        float(t) + float(c)
-        for p in row.people
-        if any(p.collision)
-        for t, c in zip(row.truth.t, p.ttc, strict=True)
-        if c is not None and t is not None
-    ]
-    return min(times) if times else None
+    ends = [earliest_contact(row.truth.t, p.ttc) for p in row.people if any(p.collision)]
+    found = [t for t in ends if t is not None]
+    return min(found) if found else None

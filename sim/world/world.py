@@ -230,7 +230,6 @@ class World(Closing):
         assert body.vehicle is not None
         sight = Sight(
             time=self.time,
-            index=self.index,
             robot=robot,
             camera=body.true_camera,
             camera_world=body.camera_world(self.scene.data),

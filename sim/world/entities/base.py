@@ -44,7 +44,6 @@ class Sight:
     frame, for times to collision)."""
 
     time: float
-    index: int
     robot: Any  # sim.world.ground_truth.RobotState (the robot's own truth)
     camera: CameraModel  # the real camera (turned by the body's pitch)
     camera_world: np.ndarray  # (3,) the camera's centre, world frame
@@ -58,8 +57,8 @@ class Sight:
 
 
 class Entity:
-    """One body in the scene. Subclasses override what they have; the defaults are a
-    static body with no motion and no truth."""
+    """One body in the scene. Subclasses add their MJCF (`build`) and override what else
+    they have; the defaults are a static body with no motion and no truth."""
 
     name: str = "entity"  # its MJCF names start with `name + "/"`
     kind: str = "body"  # what it is to the truth ("person", "parked car": what hides whom)
@@ -69,8 +68,9 @@ class Entity:
         return self.name + "/"
 
     def build(self, spec: mujoco.MjSpec) -> None:
-        """Add the body's MJCF (bodies, geoms, materials, lights) to the scene's spec."""
-        raise NotImplementedError
+        """Add the body's MJCF (bodies, geoms, materials, lights) to the scene's spec: every
+        kind of body has its own, so a kind that forgets it fails here."""
+        raise NotImplementedError(f"{type(self).__name__} adds no MJCF (Entity.build)")
 
     def bind(self, model: mujoco.MjModel, data: mujoco.MjData) -> None:
         """Find the body's own ids in the compiled model."""
