@@ -12,7 +12,9 @@ install: $(STAMP)
 # (Re)install when the project's dependency pins change.
 $(STAMP): pyproject.toml requirements.lock
 	@test -x $(BIN)/python || $(PY) -m venv $(VENV)
-	$(BIN)/python -m pip install -q -c requirements.lock -e '.[dev,ray,ncap,openvino,tracking]'
+	$(BIN)/python -m pip install -q -c requirements.lock -e '.[dev,ray,ncap,openvino,tracking,crowd]'
+	# JuPedSim (crowds) without its viewer's PySide6 and VTK: pyproject.toml's `crowd` says why.
+	$(BIN)/python -m pip install -q --no-deps -c requirements.lock jupedsim
 	@touch $(STAMP)
 
 # The pipeline on the shipped clip, then the default sweep of every case and family

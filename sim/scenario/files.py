@@ -24,6 +24,8 @@ from monopic.cases import Case
 from monopic.errors import UserError
 from sim.scenario import presets
 from sim.scenario.cases import PLACEMENT_FIELDS, CasePlacement
+from sim.scenario.crowd import crowd_from_table
+from sim.scenario.crowd_motion import capacity_problem
 from sim.scenario.families import (
     BODIES,
     CLOTHING,
@@ -666,6 +668,7 @@ def build(
             case, x_line = case_k, x_line_k
         people.append(person)
     occluders = _parked_cars(top.table("scene").table("parked_cars"), x_line, robot, road)
+    crowd = crowd_from_table(top.table("crowd"), road)
     top.done()
     _check_names(people, [t for t, _ in tables])
     scene = SceneSpec(occluders=occluders, road=road, lighting=lighting)
@@ -681,12 +684,24 @@ def build(
         horizon=horizon,
         seed=seed,
         bystanders=tuple(people[1:]),
+        crowd=crowd,
     )
+    if crowd is not None:
+        _check_crowd(path, scenario)
     paths = [t.prefix for _, t in tables]
     labels = [person_label(scenario, k, origins.get(k, "")) for k in range(len(people))]
     _check_on_street(path, scenario, paths, labels)
     _check_people(path, scenario, paths, labels)
     return scenario
+
+
+def _check_crowd(path: Path, s: Scenario) -> None:
+    """The crowd fits the street where it starts, and its names are its own."""
+    assert s.crowd is not None
+    problem = capacity_problem(s.crowd, s)
+    if problem is not None:
+        key, value, reason = problem
+        raise StreetError(path, f"crowd.{key}", value, reason)
 
 
 def _people_tables(top: TomlTable) -> list[tuple[TomlTable, TomlTable]]:
@@ -1056,7 +1071,7 @@ def street_problem(
     paths = person_paths(s) if paths is None else paths
     labels = [person_label(s, k) for k in range(len(s.people))] if labels is None else labels
     x0, x1, y0, y1 = street_bounds(road)
-    for k, person in enumerate(s.people):
+    for k, person in enumerate(s.planned):  # the crowd keeps to its street itself
         ped = pedestrian_path(person, s.duration, s.seed)
         # Every vertex at once: a human walker's track has one every 10 ms.
         times = np.array([0.0, *ped.breakpoints_between(0.0, s.duration), s.duration])

@@ -9,6 +9,8 @@ the walker.
 
 from __future__ import annotations
 
+import zlib
+
 import numpy as np
 
 from sim.scenario.plan import anchored_plan
@@ -34,3 +36,9 @@ def pedestrian_path(spec: PedestrianSpec, t_end: float, seed: int = 0) -> Track:
         miss = np.array([anchor.x, anchor.y]) - walked.state(anchor.time).position
         track = track.translated(miss)
     return track
+
+
+def walk_seed(seed: int, name: str, scripted: bool) -> int:
+    """The seed of a person's own walk: the run's for the scripted person (as with one
+    person), the run's and their name's for anyone else, so no two wander alike."""
+    return seed if scripted else (seed + zlib.crc32(name.encode())) % 2**31

@@ -95,7 +95,7 @@ def parked_car_contact(s: Scenario) -> CarContact | None:
     cars = s.scene.occluders
     if not cars:
         return None
-    for k, person in enumerate(s.people):
+    for k, person in enumerate(s.planned):  # the crowd model keeps its own off the cars
         track = planned_path(person, s)
         times = sample_times(track, s.duration, s.dt)
         xy = track.positions_at(times)
@@ -113,7 +113,7 @@ def parked_car_contact(s: Scenario) -> CarContact | None:
 def start_overlap(s: Scenario) -> tuple[int, int] | None:
     """The first two people (indices, the earlier first) whose planned footprints overlap
     at the start; None when everyone stands apart."""
-    starts = [planned_path(p, s).state(0.0) for p in s.people]
+    starts = [planned_path(p, s).state(0.0) for p in s.planned]  # the crowd's: its own
     for k in range(1, len(starts)):
         for j in range(k):
             a, b = starts[j], starts[k]

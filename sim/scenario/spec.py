@@ -18,7 +18,7 @@ from monopic.variants.zone import RobotGeometry
 from sim.scenario import presets
 from sim.scenario.lighting import DAY, PRESETS, Lighting
 from sim.scenario.plan import Anchor, Leg
-from sim.scenario.walkers import RailWalker, Walker
+from sim.scenario.walkers import HumanWalker, RailWalker, Walker
 
 RGB = tuple[float, float, float]
 
@@ -203,6 +203,69 @@ class PedestrianSpec:
         return math.radians(self.heading_deg + turn)
 
 
+CROWD_PREFIX = "crowd"  # a crowd member's name: crowd-1, crowd-2, ...
+
+
+@dataclass(frozen=True)
+class Crowd:
+    """People a pedestrian-dynamics model moves together (JuPedSim: sim.scenario.crowd_motion).
+
+    `along` walk along the pavements (both sides, both ways), `across` cross the road
+    within `cross_region` to the other pavement, `queue` wait at the near kerb around
+    `queue_x` and cross together at `release`. Everyone starts within `region` (world x)
+    at a place drawn per run; a share `groups` of them walk in groups of 2-3 (the same way
+    at the same desired speed). Desired speeds are drawn from a normal law (`speed`,
+    `speed_spread`). Each member shows the cues of `cues` (a human walker's head checks;
+    its motion parameters are not used: the crowd model moves them). Keys, units and
+    sources: scenarios/README.md.
+    """
+
+    along: int = 0
+    across: int = 0
+    queue: int = 0
+    region: tuple[float, float] = (0.0, 30.0)  # m, world x where the crowd starts
+    cross_region: tuple[float, float] = (8.0, 16.0)  # m, world x where people cross
+    queue_x: float = 12.0  # m, world x of the queue's head at the near kerb
+    release: float = 6.0  # s, when the queue crosses
+    groups: float = 0.3  # share of the people walking in groups of 2-3
+    speed: float = 1.34  # m/s, mean desired speed
+    speed_spread: float = 0.26  # m/s, its standard deviation
+    looks: tuple[MannequinSpec, ...] = ()  # one per member: along, across, then queue
+    cues: HumanWalker = field(default_factory=HumanWalker)
+    footprint: float = presets.FOOTPRINT  # m, each member's square on the ground
+
+    def __post_init__(self) -> None:
+        if min(self.along, self.across, self.queue) < 0 or len(self.looks) != self.count:
+            raise ValueError("a crowd needs counts >= 0 and one look per member")
+
+    @property
+    def count(self) -> int:
+        return self.along + self.across + self.queue
+
+    def role(self, k: int) -> str:
+        """Member k's part: "along", "across" or "queue"."""
+        return "along" if k < self.along else "across" if k < self.along + self.across else "queue"
+
+    def members(self) -> tuple[PedestrianSpec, ...]:
+        """Each member as a person of the street: name, looks and footprint (where they
+        are comes from the crowd's motion, not from this plan, which stands them at the
+        region's start)."""
+        x = self.region[0]
+        return tuple(
+            PedestrianSpec(
+                x=x,
+                y=0.0,
+                heading_deg=0.0,
+                speed=0.0,
+                looks=looks,
+                footprint=self.footprint,
+                behaviour=self.cues,
+                name=f"{CROWD_PREFIX}-{k + 1}",
+            )  # fmt: skip
+            for k, looks in enumerate(self.looks)
+        )
+
+
 @dataclass(frozen=True)
 class SceneSpec:
     occluders: tuple[Occluder, ...] = ()  # e.g. Occluder.parked_car(x, y)
@@ -227,6 +290,8 @@ class Scenario:
     # The other people in the street. `pedestrian` is the scripted one: in a collision
     # family the person whose path meets the robot; the warnings are judged against them.
     bystanders: tuple[PedestrianSpec, ...] = ()
+    # People moved together by a crowd model, after the scripted person and bystanders.
+    crowd: Crowd | None = None
 
     def __post_init__(self) -> None:
         for name in ("duration", "dt", "horizon"):
@@ -243,7 +308,13 @@ class Scenario:
 
     @property
     def people(self) -> tuple[PedestrianSpec, ...]:
-        """Everyone in the street, the scripted person first."""
+        """Everyone in the street: the scripted person, the bystanders, the crowd."""
+        return (*self.planned, *(self.crowd.members() if self.crowd else ()))
+
+    @property
+    def planned(self) -> tuple[PedestrianSpec, ...]:
+        """The people who walk a plan of their own (their walker's Track), the scripted
+        person first; the crowd's members move together instead."""
         return (self.pedestrian, *self.bystanders)
 
 
@@ -266,8 +337,9 @@ def scenario_text(s: Scenario) -> str:
         "bystanders": tuple(_Written(person_identity(p)) for p in s.bystanders),
         "scene": _Written(scene_identity(s.scene)),
     }
+    unset = {"bystanders": not s.bystanders, "crowd": s.crowd is None}
     parts = [f"{f.name}={written.get(f.name, getattr(s, f.name))!r}" for f in fields(s)
-             if not (f.name == "bystanders" and not s.bystanders)]  # fmt: skip
+             if not unset.get(f.name, False)]  # fmt: skip
     # (A field added since identities were first written shows only when it is set, so a
     # scenario that does not use it keeps its identity.)
     return f"Scenario({', '.join(parts)})"

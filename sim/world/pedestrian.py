@@ -18,7 +18,7 @@ from highway_env.vehicle.objects import RoadObject
 from sim.geometry.highway_frame import reflect, world_to_highway
 from sim.scenario.path import pedestrian_path
 from sim.scenario.spec import PedestrianSpec
-from sim.scenario.track import PathState
+from sim.scenario.track import PathState, Track
 from sim.world.gait import Gait
 
 
@@ -39,15 +39,17 @@ class Pedestrian(RoadObject):
         *,
         t_end: float = 30.0,
         seed: int = 0,
+        path: Track | None = None,
     ) -> None:
         """`t_end`: how far ahead the walk is worked out (the run and the truth's lookahead);
-        `seed`: the walk's own randomness (a human walker's wander)."""
+        `seed`: the walk's own randomness (a human walker's wander); `path`: a walk worked
+        out elsewhere (a crowd's), else the spec's own."""
         if not (math.isfinite(spec.footprint) and spec.footprint > 0):
             raise ValueError(f"pedestrian footprint must be positive, got {spec.footprint}")
         # Per-instance size, set before RoadObject.__init__ computes the diagonal from it.
         self.LENGTH = spec.footprint
         self.WIDTH = spec.footprint
-        self.path = pedestrian_path(spec, t_end, seed)
+        self.path = pedestrian_path(spec, t_end, seed) if path is None else path
         self.gait = gait or Gait(height=spec.looks.height)
         self.gait_phase = 0.0
         self.time = 0.0

@@ -34,6 +34,7 @@ from monopic.closing import Closing
 from monopic.frame import EgoState, Frame
 from sim.scenario.spec import Scenario, person_name
 from sim.world.entities.base import Entity, Moment, Sight
+from sim.world.entities.crowd import CrowdDirector
 from sim.world.entities.pedestrian import PedestrianBody
 from sim.world.entities.robot import RobotBody
 from sim.world.ground_truth import CASE_WINDOW, GroundTruth, PersonTruth, RobotState
@@ -63,15 +64,19 @@ class WorldStep:
 def scenario_entities(scenario: Scenario, t_end: float) -> list[Entity]:
     """The bodies of a scenario's world, in the order the scene builds them: its parked
     cars, its lights, the robot and its people, the scripted one first (each walking
-    `t_end` seconds ahead)."""
+    `t_end` seconds ahead), the crowd's members after a CrowdDirector that gives them
+    their walks."""
     people = [
         PedestrianBody(p.looks, p, name=person_name(p, k), t_end=t_end, scripted=k == 0)
         for k, p in enumerate(scenario.people)
     ]
+    planned = len(scenario.planned)
+    crowd = [CrowdDirector(scenario, people[planned:], t_end)] if scenario.crowd else []
     return [
         *parked_cars(scenario.scene),
         *lights(scenario.scene.lighting),
         RobotBody(scenario.robot.camera.model(), scenario.robot),
+        *crowd,
         *people,
     ]
 

@@ -9,7 +9,6 @@ with `pose_at`.
 from __future__ import annotations
 
 import math
-import zlib
 from dataclasses import replace
 
 import mujoco
@@ -19,7 +18,9 @@ from highway_env.road.road import Road
 from monopic.camera import CameraModel
 from sim.geometry.frames import Pose2D, wrap_angle
 from sim.geometry.polygons import rectangle
+from sim.scenario.path import walk_seed
 from sim.scenario.spec import MannequinSpec, PedestrianSpec
+from sim.scenario.track import Track
 from sim.world.body import PedestrianTruth, make_truth
 from sim.world.entities.base import Entity, Moment, Sight
 from sim.world.gait import Gait, MannequinPose
@@ -62,6 +63,8 @@ class PedestrianBody(Entity):
         self.walk = walk
         self.t_end = t_end
         self.scripted = scripted  # the person the run's warnings are judged against
+        # A walk worked out with others (a crowd's member: follow), else None: their own.
+        self.given_path: Track | None = None
         self.gait = Gait(height=looks.height)
         self.walker: Pedestrian | None = None
         # Where the body was last stood (the truth's placement, gait phase and speed).
@@ -90,11 +93,17 @@ class PedestrianBody(Entity):
         each other person's from the seed and their name, so no two wander alike."""
         if self.walk is None:
             raise RuntimeError(f"pedestrian {self.name!r} has no walk to start")
-        if not self.scripted:
-            seed = (seed + zlib.crc32(self.name.encode())) % 2**31
-        self.walker = Pedestrian(road, self.walk, self.gait, t_end=self.t_end, seed=seed)
+        seed = walk_seed(seed, self.name, self.scripted)
+        self.walker = Pedestrian(
+            road, self.walk, self.gait, t_end=self.t_end, seed=seed, path=self.given_path
+        )
         self.walker.reset(gait_phase=float(rng.uniform()))
         road.objects.append(self.walker)
+
+    def follow(self, path: Track) -> None:
+        """Walk `path` from the next reset on (a crowd's member: the crowd model moves
+        everyone together, sim.world.entities.crowd)."""
+        self.given_path = path
 
     def before_step(self, dt: float) -> None:
         assert self.walker is not None

@@ -1,0 +1,394 @@
+"""The crowd's motion: JuPedSim moves a scenario's crowd together, around everyone else.
+
+A crowd (sim.scenario.spec.Crowd) is walked by JuPedSim's collision-free speed model
+(Tordeux, Chraibi and Seyfried 2016; `CollisionFreeSpeedModelV2`, whose repulsion
+parameters are per agent): each person keeps a gap to the person ahead and turns away from
+neighbours and walls, so nobody walks through anybody. The walkable area is the street's
+pavements, a strip of road where people cross (`cross_region`) and a corridor along each
+planned person's path. The planned people (the scripted person and the bystanders, whose
+walks are their own walkers') are agents too, steered exactly along their Tracks (a direct
+steering stage, with no repulsion of their own): the crowd makes way for them, and they keep
+their meeting with the robot.
+
+The crowd does not see the robot: its people walk as they would beside a street (the run is
+open-loop, as every walker's is). Everything drawn per run (start places, ways, groups,
+desired speeds, cues) comes from the run's seed: the same run, the same crowd.
+
+JuPedSim is the optional extra `crowd` (its package asks for a viewer, PySide6 and VTK, that
+the simulation never uses: the Makefile installs it without them).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from monopic.errors import UserError
+from sim.scenario.families import street_bounds
+from sim.scenario.path import pedestrian_path, walk_seed
+from sim.scenario.spec import Crowd, Scenario, person_name
+from sim.scenario.track import Track
+from sim.scenario.walkers.human import intent_cues
+
+DT = 0.01  # s, JuPedSim's step (its own examples' value)
+SAMPLE = 5  # steps between the Track's vertices (0.05 s)
+RADIUS = 0.25  # m, a person's radius to the model: the footprint's half side
+PROXY_RADIUS = 0.2  # m, a planned person's: they never move for the crowd
+SPACING = 0.8  # m, at least between two people's starts (JuPedSim refuses overlaps)
+KERB_MARGIN = 0.3  # m kept from the pavement's edges at the start
+SPEED_LIMITS = (0.6, 2.2)  # m/s, desired speeds drawn outside are clipped (Weidmann's span)
+GROUP_REACH = 2.0  # m, how far apart at the start two people of a group may be
+MARGIN = 30.0  # m of street beyond where anyone starts: nobody reaches its end in a run
+CAPACITY = 0.5  # people per square metre of their start area at most (the model's packing)
+QUEUE_SPACING = 0.7  # m between places in the queue, along and away from the kerb
+QUEUE_ROW = 3  # places per row at the kerb
+SETTING_OFF = 0.3  # m/s: above it a person walks (a start or a stop for the cues)
+SEED_TAG = 0x4352  # "CR": the crowd's own stream of the run's seed
+
+
+def people_tracks(s: Scenario, seed: int, t_end: float) -> tuple[Track, ...]:
+    """Everyone's Track in the order of s.people: the planned people's walks, then the
+    crowd's, which make way for them."""
+    planned = tuple(
+        pedestrian_path(p, t_end, walk_seed(seed, person_name(p, k), k == 0))
+        for k, p in enumerate(s.planned)
+    )
+    if s.crowd is None or s.crowd.count == 0:
+        return planned
+    return (*planned, *crowd_tracks(s, planned, seed, t_end))
+
+
+@dataclass(frozen=True)
+class Street:
+    """The crowd's part of the street: pavements' y spans (near = south, far = north), the
+    x span it may use, and the kerbs' y."""
+
+    x0: float
+    x1: float
+    near: tuple[float, float]  # y span of the near (south) pavement
+    far: tuple[float, float]  # y span of the far (north) pavement
+
+    def pavement(self, side: str, x0: float, x1: float, margin: float = KERB_MARGIN):
+        import shapely
+
+        y0, y1 = self.near if side == "near" else self.far
+        return shapely.box(x0, y0 + margin, x1, y1 - margin)
+
+
+def street_of(s: Scenario, crowd: Crowd, planned: Sequence[Track], t_end: float) -> Street:
+    x_min, x_max, y_min, y_max = street_bounds(s.scene.road)
+    y_right, y_left = s.scene.road.edges
+    starts = [float(t.state(0.0).position[0]) for t in planned]
+    lo = min(crowd.region[0], crowd.cross_region[0], crowd.queue_x, *starts) - MARGIN
+    hi = max(crowd.region[1], crowd.cross_region[1], crowd.queue_x, *starts) + MARGIN
+    return Street(max(lo, x_min), min(hi, x_max), (y_min, y_right), (y_left, y_max))
+
+
+def start_area(crowd: Crowd, street: Street, role: str):
+    """Where the members of a role start (a shapely geometry)."""
+    import shapely
+
+    x0, x1 = crowd.region if role == "along" else crowd.cross_region
+    if role == "queue":
+        return queue_area(crowd, street)
+    return shapely.union(street.pavement("near", x0, x1), street.pavement("far", x0, x1))
+
+
+def start_room(crowd: Crowd, street: Street, role: str) -> float:
+    """Square metres of a role's start area (as start_area draws it, without JuPedSim)."""
+
+    def width(span: tuple[float, float]) -> float:
+        return max(span[1] - span[0] - 2 * KERB_MARGIN, 0.0)
+
+    if role == "queue":
+        rows = math.ceil(crowd.queue / QUEUE_ROW)
+        return (QUEUE_ROW * QUEUE_SPACING + 4.0 + rows) * width(street.near)
+    x0, x1 = crowd.region if role == "along" else crowd.cross_region
+    return (x1 - x0) * (width(street.near) + width(street.far))
+
+
+def queue_places(crowd: Crowd, street: Street) -> list[tuple[float, float]]:
+    """The queue's places at the near kerb, the head first: rows of QUEUE_ROW along the
+    kerb, each row QUEUE_SPACING further back."""
+    kerb = street.near[1]
+    places = []
+    for k in range(crowd.queue):
+        row, col = divmod(k, QUEUE_ROW)
+        places.append((crowd.queue_x + col * QUEUE_SPACING, kerb - 0.4 - row * QUEUE_SPACING))
+    return places
+
+
+def queue_area(crowd: Crowd, street: Street):
+    """Where the queue's people start: the near pavement behind and beside the queue."""
+    rows = math.ceil(crowd.queue / QUEUE_ROW)
+    x0 = crowd.queue_x - 2.0
+    x1 = crowd.queue_x + QUEUE_ROW * QUEUE_SPACING + 2.0 + rows
+    return street.pavement("near", x0, x1)
+
+
+def capacity_problem(crowd: Crowd, s: Scenario) -> tuple[str, int, str] | None:
+    """(key, value, reason) when a part of the crowd is larger than its start area holds
+    (CAPACITY people a square metre), None when it fits."""
+    street = street_of(s, crowd, (), 0.0)
+    for role in ("along", "across", "queue"):
+        n = getattr(crowd, role)
+        if n == 0:
+            continue
+        area = start_room(crowd, street, role)
+        most = int(area * CAPACITY)
+        if n > most:
+            where = {"along": "region", "across": "cross_region", "queue": "queue_x"}[role]
+            return role, n, (
+                f"the street holds at most {most} people there ({area:.0f} m2 of pavement "
+                f"at {CAPACITY:g} a square metre, set by crowd.{where}): fewer people or a "
+                "longer stretch"
+            )  # fmt: skip
+    return None
+
+
+def crowd_tracks(s: Scenario, planned: Sequence[Track], seed: int, t_end: float) -> list[Track]:
+    """The crowd's members' Tracks from 0 to t_end (standing after), making way for the
+    planned people whose Tracks are `planned`."""
+    try:
+        import jupedsim as jps
+        import shapely
+    except ImportError:
+        raise UserError(
+            "a crowd needs JuPedSim: install the extra (`make install` does; by hand: "
+            "pip install --no-deps jupedsim==1.4.2 shapely deprecated)"
+        ) from None
+    crowd = s.crowd
+    assert crowd is not None
+    rng = np.random.default_rng([int(seed), SEED_TAG])
+    street = street_of(s, crowd, planned, t_end)
+    area = walkable_area(s, crowd, street, planned, t_end)
+    sim = jps.Simulation(model=jps.CollisionFreeSpeedModelV2(), geometry=area, dt=DT)
+
+    # The planned people: steered exactly along their Tracks.
+    steer = sim.add_direct_steering_stage()
+    steer_journey = sim.add_journey(jps.JourneyDescription([steer]))
+    proxies = []
+    for track in planned:
+        x, y = track.state(0.0).position
+        params = jps.CollisionFreeSpeedModelV2AgentParameters(
+            position=(float(x), float(y)), journey_id=steer_journey, stage_id=steer,
+            radius=PROXY_RADIUS, desired_speed=0.0, time_gap=0.1,
+            strength_neighbor_repulsion=0.0, strength_geometry_repulsion=0.0,
+        )  # fmt: skip
+        proxies.append((sim.add_agent(params), track))
+
+    # The crowd's starts, clear of the planned people's.
+    taken = shapely.union_all(
+        [shapely.Point(t.state(0.0).position).buffer(SPACING) for t in planned]
+    )
+    starts: list[tuple[float, float]] = []
+    roles = [crowd.role(k) for k in range(crowd.count)]
+    for role in ("along", "across", "queue"):
+        n = roles.count(role)
+        if n:
+            free = start_area(crowd, street, role).difference(taken)
+            placed = distribute(jps, free, n, int(rng.integers(2**31)), role)
+            starts.extend(placed)
+            taken = taken.union(shapely.MultiPoint(placed).buffer(SPACING / 2))
+    speeds = np.clip(rng.normal(crowd.speed, crowd.speed_spread, crowd.count), *SPEED_LIMITS)
+    groups = form_groups(crowd, starts, street, rng)
+    ways = np.where(rng.uniform(size=crowd.count) < 0.5, 1.0, -1.0)
+    for group in groups:  # a group walks one way at one speed
+        speeds[group] = speeds[group[0]]
+        ways[group] = ways[group[0]]
+
+    queue = None
+    if crowd.queue:
+        queue = sim.add_waiting_set_stage(queue_places(crowd, street))
+    agents = []
+    for k, (role, start) in enumerate(zip(roles, starts, strict=True)):
+        stages = route(sim, crowd, street, role, start, ways[k], queue)
+        journey = jps.JourneyDescription(stages)
+        for a, b in zip(stages, stages[1:], strict=False):
+            journey.set_transition_for_stage(a, jps.Transition.create_fixed_transition(b))
+        params = jps.CollisionFreeSpeedModelV2AgentParameters(
+            position=start, journey_id=sim.add_journey(journey), stage_id=stages[0],
+            radius=RADIUS, desired_speed=float(speeds[k]),
+        )  # fmt: skip
+        agents.append(sim.add_agent(params))
+
+    n_steps = int(math.ceil(t_end / DT)) + SAMPLE
+    positions = np.full((n_steps // SAMPLE + 1, crowd.count, 2), np.nan)
+    headings = np.full((n_steps // SAMPLE + 1, crowd.count), np.nan)
+    record(sim, agents, positions, headings, 0)
+    for i in range(1, n_steps + 1):
+        for agent_id, track in proxies:
+            steer_along(sim, agent_id, track, sim.elapsed_time() + DT)
+        if queue is not None and abs(sim.elapsed_time() - crowd.release) < DT / 2:
+            sim.get_stage(queue).state = jps.WaitingSetState.INACTIVE
+        sim.iterate()
+        if i % SAMPLE == 0:
+            record(sim, agents, positions, headings, i // SAMPLE)
+    times = np.arange(positions.shape[0]) * SAMPLE * DT
+    names = [m.name for m in crowd.members()]
+    return [
+        member_track(crowd, times, positions[:, k], headings[:, k], walk_seed(seed, name, False))
+        for k, name in enumerate(names)
+    ]
+
+
+def walkable_area(s: Scenario, crowd: Crowd, street: Street, planned: Sequence[Track],
+                  t_end: float):  # fmt: skip
+    """Pavements, the crossing strip and a corridor along each planned person's path over
+    the run, less the parked cars."""
+    import shapely
+
+    pieces = [street.pavement(side, street.x0, street.x1, 0.0) for side in ("near", "far")]
+    x0, x1 = crowd.cross_region
+    pieces.append(shapely.box(x0, street.near[0], x1, street.far[1]))
+    if crowd.queue:
+        x1 = crowd.queue_x + QUEUE_ROW * QUEUE_SPACING + 1.0
+        pieces.append(shapely.box(crowd.queue_x - 1.0, street.near[0], x1, street.far[1]))
+    times = np.arange(0.0, t_end + 2 * DT, 0.1)
+    for track in planned:
+        line = track.positions_at(times)
+        pieces.append(shapely.LineString(line).buffer(0.6) if len(np.unique(line, axis=0)) > 1
+                      else shapely.Point(line[0]).buffer(0.6))  # fmt: skip
+    area = shapely.union_all(pieces)
+    for car in s.scene.occluders:
+        box = shapely.box(-car.length / 2, -car.width / 2, car.length / 2, car.width / 2)
+        box = shapely.affinity.rotate(box, car.yaw, origin=(0, 0))
+        area = area.difference(shapely.affinity.translate(box, car.x, car.y))
+    return area
+
+
+def distribute(jps, area, n: int, seed: int, role: str) -> list[tuple[float, float]]:
+    """n starts in `area`, SPACING apart and KERB_MARGIN from its edges (JuPedSim's own
+    sampler); a part of the crowd the area cannot hold is a UserError."""
+    import shapely
+
+    polygon = area if isinstance(area, shapely.Polygon) else max(area.geoms, key=lambda g: g.area)
+    parts = list(area.geoms) if isinstance(area, shapely.MultiPolygon) else [polygon]
+    weights = np.array([p.area for p in parts])
+    counts = np.floor(n * weights / weights.sum()).astype(int)
+    counts[np.argmax(weights)] += n - counts.sum()
+    out: list[tuple[float, float]] = []
+    for part, count in zip(parts, counts, strict=True):
+        if count == 0:
+            continue
+        try:
+            out.extend(jps.distribute_by_number(
+                polygon=part, number_of_agents=int(count), distance_to_agents=SPACING,
+                distance_to_polygon=0.15, seed=seed, max_iterations=20_000,
+            ))  # fmt: skip
+        except Exception as err:  # JuPedSim's own errors: too many for the area
+            raise UserError(
+                f"crowd.{role} = {n}: cannot place {count} people {SPACING:g} m apart in "
+                f"{part.area:.0f} m2 ({err})"
+            ) from None
+    return [(float(x), float(y)) for x, y in out]
+
+
+def form_groups(crowd: Crowd, starts: Sequence[tuple[float, float]], street: Street,
+                rng: np.random.Generator) -> list[list[int]]:  # fmt: skip
+    """Groups of 2-3 among the people walking along, nearest neighbours on the same
+    pavement within GROUP_REACH, until `crowd.groups` of them are in one (or nobody is
+    near enough)."""
+    along = list(range(crowd.along))
+    want = round(crowd.groups * crowd.along)
+    free = set(along)
+    xy = np.array(starts[: crowd.along]).reshape(-1, 2)
+    groups: list[list[int]] = []
+    for k in rng.permutation(along):
+        if sum(map(len, groups)) >= want:
+            break
+        if k not in free:
+            continue
+        size = 3 if rng.uniform() < 0.3 else 2
+        side = xy[k, 1] > street.far[0] - 0.01
+        near = sorted(
+            (float(np.hypot(*(xy[j] - xy[k]))), j)
+            for j in free
+            if j != k and (xy[j, 1] > street.far[0] - 0.01) == side
+        )
+        mates = [j for d, j in near if d <= GROUP_REACH][: size - 1]
+        if mates:
+            group = [int(k), *mates]
+            groups.append(group)
+            free -= set(group)
+    return groups
+
+
+def route(sim, crowd: Crowd, street: Street, role: str, start: tuple[float, float],
+          way: float, queue: int | None) -> list[int]:  # fmt: skip
+    """The stages a member walks: along their pavement to its end; across to the other
+    pavement, then along it; to the queue, across when it is released, then along."""
+    x, y = start
+    far_side = y > street.far[0] - 0.01
+    end_x = street.x1 - 1.0 if way > 0 else street.x0 + 1.0
+
+    def along(at_y: float) -> list[int]:
+        return [sim.add_waypoint_stage((end_x, at_y), 1.0), exit_at(sim, end_x, at_y)]
+
+    if role == "along":
+        return along(y)
+    other = street.near if far_side else street.far
+    if role == "queue":
+        other = street.far
+    middle = (other[0] + other[1]) / 2
+    if role == "across":
+        return [sim.add_waypoint_stage((x, middle), 0.5), *along(middle)]
+    assert queue is not None
+    return [queue, sim.add_waypoint_stage((crowd.queue_x + 0.7, middle), 0.5), *along(middle)]
+
+
+def exit_at(sim, x: float, y: float) -> int:
+    return sim.add_exit_stage([(x - 0.5, y - 0.5), (x + 0.5, y - 0.5), (x + 0.5, y + 0.5),
+                               (x - 0.5, y + 0.5)])  # fmt: skip
+
+
+def steer_along(sim, agent_id: int, track: Track, t: float) -> None:
+    """Send a planned person's agent to where their Track is at t, at the speed that gets
+    them there in one step (no repulsion of their own: exactly there)."""
+    agent = sim.agent(agent_id)
+    want = track.state(t).position
+    here = np.asarray(agent.position)
+    agent.target = (float(want[0]), float(want[1]))
+    agent.model.desired_speed = float(np.hypot(*(want - here)) / DT)
+
+
+def record(sim, agents: Sequence[int], positions: np.ndarray, headings: np.ndarray,
+           row: int) -> None:  # fmt: skip
+    """Every member's position and heading now (a member who has left stays unrecorded:
+    NaN, filled as standing where they were last)."""
+    alive = {a.id: a for a in sim.agents()}
+    for k, agent_id in enumerate(agents):
+        agent = alive.get(agent_id)
+        if agent is not None:
+            positions[row, k] = agent.position
+            ox, oy = agent.orientation
+            headings[row, k] = math.atan2(oy, ox)
+
+
+def member_track(crowd: Crowd, times: np.ndarray, xy: np.ndarray, heading: np.ndarray,
+                 seed: int) -> Track:  # fmt: skip
+    """A member's Track: the model's positions, facing where they walk (held while they
+    stand), with the human walker's cues (crowd.cues) at their starts, stops and every
+    check interval."""
+    keep = ~np.isnan(xy[:, 0])
+    last = int(np.flatnonzero(keep)[-1])
+    xy, heading = xy.copy(), heading.copy()
+    xy[last + 1 :] = xy[last]
+    heading[last + 1 :] = heading[last]
+    steps = np.diff(xy, axis=0)
+    speed = np.hypot(steps[:, 0], steps[:, 1]) / np.diff(times)
+    speeds = np.concatenate([[speed[0]], speed])  # the speed each vertex is reached at
+    walking = speeds > SETTING_OFF
+    # Piece k's heading: its step's while walking, else the model's facing (held).
+    ahead = np.arctan2(steps[:, 1], steps[:, 0])
+    moving = np.concatenate([speed > SETTING_OFF, [False]])
+    yaw = np.where(moving, np.concatenate([ahead, ahead[-1:]]), heading)
+    events: list[tuple[float, str]] = []
+    changes = np.flatnonzero(np.diff(walking.astype(int)))
+    for i in changes:
+        events.append((float(times[i + 1]), "set-off" if walking[i + 1] else "stop"))
+    head, torso = intent_cues(crowd.cues, times, yaw, speeds, events, seed)
+    return Track.from_vertices(times, xy, yaw, np.zeros(2), head_yaws=head, torso_yaws=torso)
