@@ -27,3 +27,8 @@ needs_street_clip = pytest.mark.skipif(
     not STREET_CLIP.is_file(),
     reason=f"the street clip is not at {STREET_CLIP} (set MONOPIC_SHARED_DATA)",
 )
+ETH_UCY = SHARED_DATA / "eth-ucy-calibration"
+needs_eth_ucy = pytest.mark.skipif(
+    not (ETH_UCY / "biwi_hotel.txt").is_file(),
+    reason=f"the ETH/UCY tracks are not at {ETH_UCY} (set MONOPIC_SHARED_DATA)",
+)

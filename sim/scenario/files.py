@@ -60,6 +60,7 @@ from sim.scenario.people import (
     planned_path,
     start_overlap,
 )
+from sim.scenario.replays import REPLAY_KEY, expand_replay, replay_person, replay_street_problem
 from sim.scenario.spec import (
     BodyPitch,
     CameraSpec,
@@ -73,7 +74,7 @@ from sim.scenario.spec import (
     person_name,
 )
 from sim.scenario.toml_table import MISSING, FieldError, TomlTable, read_toml, show
-from sim.scenario.walkers import Walker, walker_from_table
+from sim.scenario.walkers import ReplayWalker, Walker, walker_from_table
 
 KINDS = ("case", "collision", "near-miss")
 PATH_KINDS = ("case", "crossing", "longitudinal", "turn-in", "explicit", "pavement")
@@ -85,7 +86,7 @@ ScenarioFileError = FieldError  # the name callers of this module know
 
 # Top-level keys by which a scenario file and a sweep spec tell themselves apart, so that
 # one given for the other is named for what it is, not for its first unknown key.
-SCENARIO_FILE_KEYS = ("path", "pedestrian", "pedestrians", "people", "robot", "scene",
+SCENARIO_FILE_KEYS = ("path", "pedestrian", "pedestrians", "people", "replay", "robot", "scene",
                       "sweep", "family", "kind", "scale", "duration", "fps", "horizon",
                       "seed")  # fmt: skip
 SWEEP_SPEC_KEY = "include"
@@ -634,6 +635,9 @@ def build(
     if PEOPLE_KEY in data:
         data, origins = resolve_people(path, data)
     origins = origins or {}
+    if REPLAY_KEY in data:  # recorded people (sim.scenario.replays), after the file's own
+        given = data.get("duration", presets.DURATION_S)
+        data, origins = expand_replay(path, data, origins, _seconds(given))
     top = TomlTable(path, "", data)
     name = top.text("name")
     family = top.text("family", name)
@@ -690,18 +694,27 @@ def build(
         _check_crowd(path, scenario)
     paths = [t.prefix for _, t in tables]
     labels = [person_label(scenario, k, origins.get(k, "")) for k in range(len(people))]
+    replayed = replay_street_problem(scenario, [t.prefix for t, _ in tables], labels)
+    if replayed is not None:
+        raise StreetError(path, replayed.field, replayed.value, replayed.reason)
     _check_on_street(path, scenario, paths, labels)
     _check_people(path, scenario, paths, labels)
     return scenario
 
 
 def _check_crowd(path: Path, s: Scenario) -> None:
-    """The crowd fits the street where it starts, and its names are its own."""
+    """The crowd fits the street where it starts (one line naming the part too large)."""
     assert s.crowd is not None
     problem = capacity_problem(s.crowd, s)
     if problem is not None:
         key, value, reason = problem
         raise StreetError(path, f"crowd.{key}", value, reason)
+
+
+def _seconds(value: Any) -> float:
+    """A duration as given, or the default when it is not one (build then refuses it)."""
+    number = isinstance(value, int | float) and not isinstance(value, bool)
+    return float(value) if number and math.isfinite(value) else presets.DURATION_S
 
 
 def _people_tables(top: TomlTable) -> list[tuple[TomlTable, TomlTable]]:
@@ -737,6 +750,9 @@ def _person(
     behaviour = walker_from_table(t.table("behaviour"))  # scenarios/README.md
     t.done()
     looks = mannequin(body, clothing, height)
+    if isinstance(behaviour, ReplayWalker):  # the file is the path (sim.scenario.replays)
+        person = replay_person(t, path_table, behaviour, looks, footprint, duration)
+        return (replace(person, name=name) if name else person), None, None
     person, case, x_line = _path(
         path_table, robot, road, speed, looks, footprint, duration, behaviour, t.prefix
     )

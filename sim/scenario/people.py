@@ -23,7 +23,7 @@ import numpy as np
 from sim.scenario.path import pedestrian_path
 from sim.scenario.spec import Occluder, PedestrianSpec, Scenario
 from sim.scenario.track import Track
-from sim.scenario.walkers import RailWalker
+from sim.scenario.walkers import RailWalker, ReplayWalker
 
 # Footprints closer than this are apart (touching is not overlapping).
 TOUCH = 1e-6  # m
@@ -42,9 +42,10 @@ class CarContact:
 def planned_path(person: PedestrianSpec, s: Scenario) -> Track:
     """A person's path as written: their plan walked by the rail target (their own walker
     when it is one), starting from standing over their walker's start distance (the one
-    the placement timed the plan with), so it meets the placement's anchor as theirs does."""
+    the placement timed the plan with), so it meets the placement's anchor as theirs does.
+    A replayed person's path as written is the recording (their own walker's track)."""
     walker = person.behaviour
-    if not isinstance(walker, RailWalker):
+    if not isinstance(walker, RailWalker | ReplayWalker):
         rail = RailWalker(acceleration_distance=walker.start_distance)
         person = replace(person, behaviour=rail)
     return pedestrian_path(person, s.duration, s.seed)

@@ -261,12 +261,12 @@ def test_a_registered_walker_type_is_chosen_by_model_and_walked_without_editing_
     swept = load(SCENARIOS / "families/small/cpna25.toml").scenario(sweep, "t", 0)
     assert swept.pedestrian.behaviour == StillWalker(facing_deg=90.0)
     assert "StillWalker(facing_deg=90.0)" in scenario_text(swept)
-    with pytest.raises(UserError, match="must be one of rail, human, still"):
+    with pytest.raises(UserError, match="must be one of rail, human, replay, still"):
         load(with_behaviour(tmp_path, 'model = "crowd"'))
 
 
 def test_the_registry_is_back_without_the_walker_a_test_added():
-    assert list(WALKERS) == ["rail", "human"]
+    assert list(WALKERS) == ["rail", "human", "replay"]
 
 
 def keys_read(walker: type) -> set[str]:

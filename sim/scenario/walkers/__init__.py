@@ -11,10 +11,12 @@ from sim.scenario.toml_table import TomlTable
 from sim.scenario.walkers.base import Walker
 from sim.scenario.walkers.human import HumanWalker
 from sim.scenario.walkers.rail import RailWalker
+from sim.scenario.walkers.replay import ReplayWalker
 
 WALKERS: dict[str, type[Walker]] = {
     RailWalker.model: RailWalker,
     HumanWalker.model: HumanWalker,
+    ReplayWalker.model: ReplayWalker,
 }
 
 
@@ -25,4 +27,4 @@ def walker_from_table(t: TomlTable) -> Walker:
     return WALKERS[model].from_table(t)
 
 
-__all__ = ["WALKERS", "HumanWalker", "RailWalker", "Walker", "walker_from_table"]
+__all__ = ["WALKERS", "HumanWalker", "RailWalker", "ReplayWalker", "Walker", "walker_from_table"]
