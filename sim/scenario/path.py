@@ -4,15 +4,19 @@ The motion is a Track (sim.scenario.track): a polyline in time that the body, hi
 and the ground truth all read. The plan (sim.scenario.plan) is walked by the spec's
 walker (sim.scenario.walkers: the Euro NCAP rail target, the human walker, ...), and a
 spec's anchor (a point at a time the placement solved for) is then met exactly, whatever
-the walker.
+the walker. people_tracks gives every person of a scenario their Track with their own
+seed (person_seed, which the world's bodies use too): the one function that answers
+"where is everyone", where people whose motion is worked out together (a crowd) plug in.
 """
 
 from __future__ import annotations
 
+import zlib
+
 import numpy as np
 
 from sim.scenario.plan import anchored_plan
-from sim.scenario.spec import PedestrianSpec
+from sim.scenario.spec import PedestrianSpec, Scenario, person_name
 from sim.scenario.track import Track
 
 
@@ -34,3 +38,20 @@ def pedestrian_path(spec: PedestrianSpec, t_end: float, seed: int = 0) -> Track:
         miss = np.array([anchor.x, anchor.y]) - walked.state(anchor.time).position
         track = track.translated(miss)
     return track
+
+
+def person_seed(seed: int, name: str, scripted: bool) -> int:
+    """A person's own seed in a run of `seed`: the scripted person's is the run's (as with
+    one person), each other person's the run's and their name, so no two wander alike."""
+    return seed if scripted else (seed + zlib.crc32(name.encode())) % 2**31
+
+
+def people_tracks(scenario: Scenario, seed: int, t_end: float) -> dict[str, Track]:
+    """Every person of the scenario (by name, the scripted one first) and their Track up
+    to at least t_end in a run of `seed`: the motion the world renders and the truth
+    reports (sim.world.entities.pedestrian walks these)."""
+    return {
+        name: pedestrian_path(person, t_end, person_seed(seed, name, k == 0))
+        for k, person in enumerate(scenario.people)
+        for name in (person_name(person, k),)
+    }

@@ -9,7 +9,6 @@ with `pose_at`.
 from __future__ import annotations
 
 import math
-import zlib
 from dataclasses import replace
 
 import mujoco
@@ -19,6 +18,7 @@ from highway_env.road.road import Road
 from monopic.camera import CameraModel
 from sim.geometry.frames import Pose2D, wrap_angle
 from sim.geometry.polygons import rectangle
+from sim.scenario.path import person_seed
 from sim.scenario.spec import MannequinSpec, PedestrianSpec
 from sim.world.body import PedestrianTruth, make_truth
 from sim.world.entities.base import Entity, Moment, Sight
@@ -90,8 +90,7 @@ class PedestrianBody(Entity):
         each other person's from the seed and their name, so no two wander alike."""
         if self.walk is None:
             raise RuntimeError(f"pedestrian {self.name!r} has no walk to start")
-        if not self.scripted:
-            seed = (seed + zlib.crc32(self.name.encode())) % 2**31
+        seed = person_seed(seed, self.name, self.scripted)
         self.walker = Pedestrian(road, self.walk, self.gait, t_end=self.t_end, seed=seed)
         self.walker.reset(gait_phase=float(rng.uniform()))
         road.objects.append(self.walker)
