@@ -3,8 +3,9 @@
 Input is what the ETH/UCY files hold, rows of (frame, person, x, y): frame numbers
 FRAME_STEP apart per STEP (0.4 s), positions in metres on the ground plane. A recording
 is one such array (a real scene, or one simulated run: sim.analysis.tracks.run_rows); a
-set of recordings (a scene, a sweep's runs) gives one CrowdSummary. Pure numpy: no
-simulator imports, so a real scene and a simulated street are measured by the same code.
+set of recordings (a scene, a sweep's runs) gives one CrowdSummary. Numpy (matplotlib
+for the plot, when drawn) and no simulator imports, so a real scene and a simulated
+street are measured by the same code.
 
 The statistics, each defined so that it is computed the same way for both:
 
@@ -15,7 +16,10 @@ The statistics, each defined so that it is computed the same way for both:
   straight steps between consecutive positions, pass through (a square per person at
   the least: about the ground one person keeps to themselves). Its convex hull would
   count the building fronts and planters a real scene's people walk around; the cells
-  count only where someone went.
+  count only where someone went. The region grows with the time watched until the
+  walkable ground is covered: a real scene is one street watched for minutes, so the
+  runs of a simulated spec (seconds each, the same street) are pooled into one region,
+  while each run keeps its own frames, people and groups.
 - distance to the nearest other person (m): over every person-frame with at least two
   people in the frame, p10 and p50.
 - groups: two people walk together when, for at least TOGETHER seconds of consecutive
@@ -45,6 +49,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 
@@ -75,7 +80,7 @@ class CrowdSummary:
     recordings: int
     people: int  # people over all recordings (ids are per recording)
     frames: int  # frames with someone in them
-    area: float  # m2, the walked region's median over recordings
+    area: float  # m2, the walked region of all recordings together
     values: dict[str, float]  # every CROWD_STATISTICS key
     nearest: np.ndarray  # every person-frame's distance to the nearest other person
     densities: np.ndarray  # every frame's people / walked area
@@ -122,6 +127,12 @@ def steps(rows: np.ndarray) -> Steps:
 
 def walked_area(rows: np.ndarray) -> float:
     """m2: the CELL squares the people's positions and their steps pass through."""
+    return float(len(walked_cells(rows)) * CELL * CELL)
+
+
+def walked_cells(rows: np.ndarray) -> np.ndarray:
+    """(k, 2) integer indices of the CELL squares the people's positions and their steps
+    pass through."""
     rows = _check(rows)
     s = steps(rows)
     points = [rows[:, 2:4]]
@@ -132,8 +143,7 @@ def walked_area(rows: np.ndarray) -> float:
         n = int(np.ceil(np.max(np.hypot(*(ends - s.position).T)) / (CELL / 4))) + 1
         for f in np.linspace(0.0, 1.0, max(n, 2)):
             points.append(s.position + f * (ends - s.position))
-    cells = np.unique(np.floor(np.concatenate(points) / CELL).astype(np.int64), axis=0)
-    return float(len(cells) * CELL * CELL)
+    return np.unique(np.floor(np.concatenate(points) / CELL).astype(np.int64), axis=0)
 
 
 def frame_counts(rows: np.ndarray) -> np.ndarray:
@@ -220,19 +230,15 @@ def _q(values: np.ndarray, p: float) -> float:
 
 
 def crowd_summary(name: str, recordings: Sequence[np.ndarray]) -> CrowdSummary:
-    """The crowd statistics over recordings measured each on its own (a person, a frame
-    and a walked region belong to one recording) and pooled."""
-    densities, nearest, differences, spreads, areas = [], [], [], [], []
-    people = walkers = grouped = frames = 0
+    """The crowd statistics of recordings of one street: each person, frame and group
+    belongs to its recording, and the walked region is the union of all of theirs (one
+    street watched several times, as a real scene is one street watched for minutes)."""
+    counts, nearest, differences, spreads, cells = [], [], [], [], []
+    people = walkers = grouped = 0
+    recordings = [r for r in (_check(r) for r in recordings) if len(r)]
     for rows in recordings:
-        rows = _check(rows)
-        if not len(rows):
-            continue
-        area = walked_area(rows)
-        areas.append(area)
-        counts = frame_counts(rows)
-        frames += len(counts)
-        densities.append(counts / area)
+        cells.append(walked_cells(rows))
+        counts.append(frame_counts(rows))
         nearest.append(nearest_distances(rows))
         pairs = group_pairs(rows)
         differences += [p.speed_difference for p in pairs]
@@ -245,7 +251,9 @@ def crowd_summary(name: str, recordings: Sequence[np.ndarray]) -> CrowdSummary:
     def joined(parts: list[np.ndarray]) -> np.ndarray:
         return np.concatenate(parts) if parts else np.array([])
 
-    d, nn, diff, spread = joined(densities), joined(nearest), joined(differences), joined(spreads)
+    area = len(np.unique(np.concatenate(cells), axis=0)) * CELL * CELL if cells else math.nan
+    d = joined(counts) / area
+    nn, diff, spread = joined(nearest), joined(differences), joined(spreads)
     values = {
         "density": _q(d, 50),
         "nn_p10": _q(nn, 10),
@@ -254,8 +262,7 @@ def crowd_summary(name: str, recordings: Sequence[np.ndarray]) -> CrowdSummary:
         "speed_spread": _q(spread, 50),
         "group_share": grouped / walkers if walkers else math.nan,
     }
-    area = float(np.median(areas)) if areas else math.nan
-    return CrowdSummary(name, len(areas), people, frames, area, values, nn, d)
+    return CrowdSummary(name, len(recordings), people, len(d), float(area), values, nn, d)
 
 
 def crowd_span(real: Sequence[CrowdSummary], stat: str, widen: float = 0.2) -> tuple[float, float]:
@@ -271,3 +278,107 @@ def judge_crowd(real: Sequence[CrowdSummary], simulated: CrowdSummary, widen: fl
         low, high = crowd_span(real, stat, widen)
         out.append(Verdict(stat, quantile, simulated.values[stat], low, high))
     return out
+
+
+# -- the report -----------------------------------------------------------------------
+
+
+def _g(value: float) -> str:
+    return "-" if math.isnan(value) else f"{value:.3g}"
+
+
+def crowd_report_text(real: Sequence[CrowdSummary], simulated: Sequence[CrowdSummary],
+                      plot: str, widen: float = 0.2) -> str:  # fmt: skip
+    """The crowd section of the realism report (Markdown): the real scenes' densities to
+    build crowds to, every set's statistics, each simulated set's verdicts, the plot."""
+    lines = [
+        "## Crowds: people among each other, at matched density",
+        "",
+        "Per frame of 0.4 s (sim/analysis/crowd_stats.py): density = people in the frame "
+        f"/ the walked region (the {CELL:g} m squares anyone's positions and steps pass "
+        "through, all runs of a spec together, as one street watched as long as a real "
+        "scene), median over frames; the distance from each person to the nearest "
+        "other, over person-frames with two people or more; a group is two people walking "
+        f"(> {WALKING} m/s) within {NEAR} m whose velocities differ by less than "
+        f"{SAME_VELOCITY} m/s for {TOGETHER:g} s or more (proximity and velocity over "
+        "time, as Ge, Collins and Ruback 2012 detect groups); the speed difference within "
+        "groups; the spread of walking speeds in a frame (p90 - p10, median over frames); "
+        "the share of walkers in a group. A simulated spec is every run's people, each run "
+        "measured on its own and pooled.",
+        "",
+        "### The real scenes' density, to build crowds to",
+        "",
+        "| scene | people | frames | walked region (m2) | density p10 / p50 / p90 over "
+        "frames (people/m2) | people in a frame p50 |",
+        "| --- | ---: | ---: | ---: | --- | ---: |",
+    ]
+    for s in real:
+        q = [_g(_q(s.densities, p)) for p in (10, 50, 90)]
+        lines.append(
+            f"| {s.name} | {s.people} | {s.frames} | {_g(s.area)} | {' / '.join(q)} "
+            f"| {_g(_q(s.densities * s.area, 50))} |"
+        )
+    head = ["set", "people", "frames", "walked region (m2)"]
+    head += [f"{label} {quantile}" for _, label, quantile in CROWD_STATISTICS]
+    lines += ["", "### Every set", "", "| " + " | ".join(head) + " |", "|" + " --- |" * len(head)]
+    for kind, sets in (("real", real), ("simulated", simulated)):
+        for s in sets:
+            cells = [f"{s.name} ({kind})", str(s.people), str(s.frames), _g(s.area)]
+            cells += [_g(s.values[k]) for k, _, _ in CROWD_STATISTICS]
+            lines.append("| " + " | ".join(cells) + " |")
+    for s in simulated:
+        verdicts = judge_crowd(real, s, widen)
+        inside = sum(v.inside for v in verdicts)
+        lines += [
+            "",
+            f"### `{s.name}` against the real scenes' span",
+            "",
+            f"Density {_g(s.values['density'])} people/m2 beside the scenes' "
+            + ", ".join(f"{r.name} {_g(r.values['density'])}" for r in real)
+            + f". Each span is the real scenes' min to max widened by {widen:.0%} "
+            f"(min x {1 - widen:g} to max x {1 + widen:g}). {inside} of {len(verdicts)} inside.",
+            "",
+            "| statistic | of | simulated | span | inside |",
+            "| --- | --- | ---: | --- | --- |",
+        ]
+        labels = {k: label for k, label, _ in CROWD_STATISTICS}
+        lines += [
+            f"| {labels[v.stat]} | {v.quantile} | {_g(v.value)} | {_g(v.low)} - {_g(v.high)} "
+            f"| {'yes' if v.inside else 'no'} |"
+            for v in verdicts
+        ]
+    lines += ["", f"![crowds]({plot})", ""]
+    return "\n".join(lines)
+
+
+def plot_crowds(real: Sequence[CrowdSummary], simulated: Sequence[CrowdSummary], path: Path,
+                title: str) -> None:  # fmt: skip
+    """Two panels, as realism.plot_distributions draws them: the share of person-frames
+    within each distance of the nearest other person, and of frames within each density."""
+    from matplotlib.figure import Figure
+
+    from monopic.output import atomic_path
+
+    fig = Figure(figsize=(10, 4.2), layout="constrained")
+    panels = (
+        ("nearest", "nearest other person (m)", "share of person-frames within"),
+        ("densities", "density (people/m2)", "share of frames within"),
+    )
+    for i, (attr, xlabel, ylabel) in enumerate(panels):
+        ax = fig.add_subplot(1, 2, i + 1)
+        sets = [(s, "-") for s in real] + [(s, "--") for s in simulated]
+        for s, style in sets:
+            v = np.sort(getattr(s, attr))
+            if len(v):
+                ax.plot(v, np.arange(1, len(v) + 1) / len(v), style, label=s.name, lw=1.4)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
+        ax.grid(alpha=0.3)
+        high = max((np.percentile(getattr(s, attr), 98) for s, _ in sets
+                    if len(getattr(s, attr))), default=1.0)  # fmt: skip
+        ax.set_xlim(0, high * 1.1 if high > 0 else 1.0)
+        if i == 0:
+            ax.legend(fontsize=7, loc="lower right")
+    fig.suptitle(title + " (solid: real scenes, dashed: simulated)", fontsize=10)
+    with atomic_path(path) as tmp:
+        fig.savefig(tmp, dpi=100, format="png")
