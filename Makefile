@@ -48,11 +48,14 @@ format: $(STAMP)
 
 # Simulated walkers beside real ones (docs/realism/report.md): free walks and the medium
 # sweep's families, human and rail, against the ETH/UCY scenes shipped beside the project
-# (read at run time, never copied in). A minute or two.
+# (read at run time, never copied in), and the crowd section: the bystanders of
+# people-pavement among each other beside the scenes (density, nearest person, groups)
+# until crowd specs of matched density exist. A minute or two.
 REAL_TRACKS ?= ../shared/data/eth-ucy-calibration
 realism: $(STAMP)
 	$(BIN)/monopic realism scenarios/sweeps/walks.toml scenarios/sweeps/walks-rail.toml \
 		scenarios/sweeps/medium-human.toml scenarios/sweeps/medium.toml \
+		--crowds scenarios/sweeps/people-pavement.toml \
 		--real $(REAL_TRACKS)/*.txt --out docs/realism --judge walks
 
 clean-venv:

@@ -17,6 +17,7 @@ walker walks (speed > WALKING on the steps involved), p50 and p90.
 from __future__ import annotations
 
 import math
+import warnings
 from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -57,14 +58,29 @@ class Summary:
     values: dict[str, np.ndarray]
 
 
-def read_tracks(path: Path) -> TrackSet:
-    """An ETH/UCY text file (`frame person x y` rows) split into gap-free tracks."""
+def read_rows(path: Path) -> np.ndarray:
+    """An ETH/UCY text file's rows as they are: an (n, 4) array of frame, person, x, y
+    (frame numbers FRAME_STEP apart per STEP seconds; ids and frames kept, for what needs
+    who stood where at the same moment)."""
     try:
-        rows = np.loadtxt(path, ndmin=2)
+        with warnings.catch_warnings():  # an empty file: said below, in one line
+            warnings.simplefilter("ignore", UserWarning)
+            rows = np.loadtxt(path, ndmin=2)
     except (OSError, ValueError) as err:
         raise UserError(f"{path}: not a track file of `frame person x y` rows ({err})") from None
+    if rows.size == 0:
+        raise UserError(f"{path}: no rows (expected `frame person x y` rows)")
     if rows.shape[1] != 4:
         raise UserError(f"{path}: rows have {rows.shape[1]} columns, expected frame person x y")
+    if not np.all(np.isfinite(rows)):
+        bad = int(np.flatnonzero(~np.all(np.isfinite(rows), axis=1))[0])
+        raise UserError(f"{path}: row {bad + 1} is not finite ({' '.join(map(str, rows[bad]))})")
+    return rows
+
+
+def read_tracks(path: Path) -> TrackSet:
+    """An ETH/UCY text file (`frame person x y` rows) split into gap-free tracks."""
+    rows = read_rows(path)
     tracks = []
     for person in np.unique(rows[:, 1]):
         mine = rows[rows[:, 1] == person]
@@ -137,8 +153,16 @@ def span(
 ) -> tuple[float, float]:
     """The real scenes' range of one statistic's p50 or p90, widened by `widen` of each end
     (min * (1 - widen), max * (1 + widen))."""
-    values = [getattr(s, quantile)[stat] for s in real]
-    return min(values) * (1 - widen), max(values) * (1 + widen)
+    return widened([getattr(s, quantile)[stat] for s in real], widen)
+
+
+def widened(values: Sequence[float], widen: float = 0.2) -> tuple[float, float]:
+    """min * (1 - widen) to max * (1 + widen) of the values that are numbers (NaN: a scene
+    with nothing to measure; all NaN gives a NaN span, which nothing is inside)."""
+    known = [v for v in values if not math.isnan(v)]
+    if not known:
+        return math.nan, math.nan
+    return min(known) * (1 - widen), max(known) * (1 + widen)
 
 
 # -- the report -----------------------------------------------------------------------

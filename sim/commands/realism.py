@@ -20,11 +20,17 @@ def register(sub: argparse._SubParsersAction) -> None:
         "|acceleration| and turn rate where walking, and the constant-velocity error at "
         "0.4, 0.8 and 1.2 s (p50 and p90). Writes DIR/report.md and DIR/distributions.png; "
         "--judge names the set whose every p50 and p90 is checked against the real scenes' "
-        "span (min to max, widened by 20 %).",
+        "span (min to max, widened by 20 %). With --crowds, a crowd section too: each real "
+        "scene's density (people per m2 of the ground its people walk), nearest-person "
+        "distance, group speed difference, speed spread and group share beside each crowd "
+        "spec's (every run's people), each judged against the real scenes' span, and "
+        "DIR/crowds.png.",
     )
     p.add_argument(
-        "specs", nargs="+", type=Path, metavar="SPEC.toml", help="sweep specs whose walkers to set"
+        "specs", nargs="*", type=Path, metavar="SPEC.toml", help="sweep specs whose walkers to set"
     )
+    p.add_argument("--crowds", nargs="+", type=Path, default=[], metavar="SPEC.toml",
+                   help="sweep specs whose runs are crowds, for the crowd section")  # fmt: skip
     p.add_argument("--real", nargs="+", type=Path, required=True, metavar="FILE",
                    help="real tracks, e.g. ../shared/data/eth-ucy-calibration/*.txt")  # fmt: skip
     p.add_argument(
@@ -51,6 +57,8 @@ def run(args: argparse.Namespace) -> int:
     from sim.analysis.tracks import sweep_tracks
     from sim.runs.sweep import expand_spec, load_spec
 
+    if not args.specs and not args.crowds:
+        raise UserError("realism: name a sweep spec (SPEC.toml) or --crowds SPEC.toml")
     for path in args.real:
         if not path.is_file():
             raise UserError(f"--real {path}: no such file")
@@ -62,22 +70,60 @@ def run(args: argparse.Namespace) -> int:
         spec = load_spec(path)
         tracks = sweep_tracks(expand_spec(spec))
         simulated.append(summarise(TrackSet(spec.name, tuple(t.positions for t in tracks))))
-    judged = args.judge or simulated[0].name
-    if judged not in {s.name for s in simulated}:
-        names = ", ".join(s.name for s in simulated)
+    judged = args.judge or (simulated[0].name if simulated else None)
+    if judged is not None and judged not in {s.name for s in simulated}:
+        names = ", ".join(s.name for s in simulated) or "none"
         raise UserError(f"--judge {judged!r}: not one of the specs' names ({names})")
+    crowd_text = _crowds(args) if args.crowds else ""
     args.out.mkdir(parents=True, exist_ok=True)
     command = "monopic realism " + " ".join(shlex.quote(a) for a in sys.argv[2:])
     plot_distributions(real, simulated, args.out / "distributions.png", "Walkers, 0.4 s steps")
-    text = report_text(real, simulated, judged, command, "distributions.png")
-    write_text_atomically(args.out / "report.md", text)
-    verdicts = judge(real, next(s for s in simulated if s.name == judged))
-    inside = sum(v.inside for v in verdicts)
-    print(f"{judged}: {inside} of {len(verdicts)} statistics inside the real scenes' span")
-    for v in verdicts:
-        if not v.inside:
-            print(
-                f"  outside: {v.stat} {v.quantile} = {v.value:.3g} (span {v.low:.3g}-{v.high:.3g})"
-            )
+    text = report_text(real, simulated, judged or "", command, "distributions.png")
+    write_text_atomically(args.out / "report.md", text + crowd_text)
+    if judged is not None:
+        verdicts = judge(real, next(s for s in simulated if s.name == judged))
+        inside = sum(v.inside for v in verdicts)
+        print(f"{judged}: {inside} of {len(verdicts)} statistics inside the real scenes' span")
+        for v in verdicts:
+            if not v.inside:
+                print(
+                    f"  outside: {v.stat} {v.quantile} = {v.value:.3g} "
+                    f"(span {v.low:.3g}-{v.high:.3g})"
+                )
     print(f"report: {args.out / 'report.md'}")
     return 0
+
+
+def _crowds(args: argparse.Namespace) -> str:
+    """The crowd section (and DIR/crowds.png), its figures printed as it goes."""
+    from sim.analysis.crowd_stats import crowd_report_text, crowd_summary, judge_crowd, plot_crowds
+    from sim.analysis.realism import read_rows
+    from sim.analysis.tracks import run_rows
+    from sim.runs.sweep import expand_spec, load_spec
+
+    real = [crowd_summary(path.stem, [read_rows(path)]) for path in args.real]
+    for s in real:
+        v = s.values
+        print(
+            f"{s.name}: density {v['density']:.3g} people/m2 over {s.area:.0f} m2 walked, "
+            f"nearest person p10 / p50 {v['nn_p10']:.3g} / {v['nn_p50']:.3g} m, group speed "
+            f"difference {v['group_speed_difference']:.3g} m/s, speed spread "
+            f"{v['speed_spread']:.3g} m/s, group share {v['group_share']:.2f}"
+        )
+    simulated = []
+    for path in args.crowds:
+        spec = load_spec(path)
+        s = crowd_summary(spec.name, [run_rows(run) for run in expand_spec(spec)])
+        simulated.append(s)
+        verdicts = judge_crowd(real, s)
+        inside = sum(v.inside for v in verdicts)
+        print(
+            f"{s.name} (crowd): density {s.values['density']:.3g} people/m2; "
+            f"{inside} of {len(verdicts)} crowd statistics inside the real scenes' span"
+        )
+        for v in verdicts:
+            if not v.inside:
+                print(f"  outside: {v.stat} = {v.value:.3g} (span {v.low:.3g}-{v.high:.3g})")
+    args.out.mkdir(parents=True, exist_ok=True)
+    plot_crowds(real, simulated, args.out / "crowds.png", "Crowds, 0.4 s frames")
+    return "\n" + crowd_report_text(real, simulated, "crowds.png")

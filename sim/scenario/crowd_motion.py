@@ -28,8 +28,8 @@ import numpy as np
 
 from monopic.errors import UserError
 from sim.scenario.families import street_bounds
-from sim.scenario.path import pedestrian_path, walk_seed
-from sim.scenario.spec import Crowd, Scenario, person_name
+from sim.scenario.path import person_seed
+from sim.scenario.spec import Crowd, Scenario
 from sim.scenario.track import Track
 from sim.scenario.walkers.human import intent_cues
 
@@ -47,18 +47,6 @@ QUEUE_SPACING = 0.7  # m between places in the queue, along and away from the ke
 QUEUE_ROW = 3  # places per row at the kerb
 SETTING_OFF = 0.3  # m/s: above it a person walks (a start or a stop for the cues)
 SEED_TAG = 0x4352  # "CR": the crowd's own stream of the run's seed
-
-
-def people_tracks(s: Scenario, seed: int, t_end: float) -> tuple[Track, ...]:
-    """Everyone's Track in the order of s.people: the planned people's walks, then the
-    crowd's, which make way for them."""
-    planned = tuple(
-        pedestrian_path(p, t_end, walk_seed(seed, person_name(p, k), k == 0))
-        for k, p in enumerate(s.planned)
-    )
-    if s.crowd is None or s.crowd.count == 0:
-        return planned
-    return (*planned, *crowd_tracks(s, planned, seed, t_end))
 
 
 @dataclass(frozen=True)
@@ -230,7 +218,7 @@ def crowd_tracks(s: Scenario, planned: Sequence[Track], seed: int, t_end: float)
     times = np.arange(positions.shape[0]) * SAMPLE * DT
     names = [m.name for m in crowd.members()]
     return [
-        member_track(crowd, times, positions[:, k], headings[:, k], walk_seed(seed, name, False))
+        member_track(crowd, times, positions[:, k], headings[:, k], person_seed(seed, name, False))
         for k, name in enumerate(names)
     ]
 

@@ -4,7 +4,8 @@ The motion is a Track (sim.scenario.track): a polyline in time that the body, hi
 and the ground truth all read. The plan (sim.scenario.plan) is walked by the spec's
 walker (sim.scenario.walkers: the Euro NCAP rail target, the human walker, ...), and a
 spec's anchor (a point at a time the placement solved for) is then met exactly, whatever
-the walker.
+the walker. person_seed gives each person of a run their own seed (the world's bodies and
+sim.scenario.motion.people_tracks, where is everyone, use it).
 """
 
 from __future__ import annotations
@@ -38,7 +39,7 @@ def pedestrian_path(spec: PedestrianSpec, t_end: float, seed: int = 0) -> Track:
     return track
 
 
-def walk_seed(seed: int, name: str, scripted: bool) -> int:
-    """The seed of a person's own walk: the run's for the scripted person (as with one
-    person), the run's and their name's for anyone else, so no two wander alike."""
+def person_seed(seed: int, name: str, scripted: bool) -> int:
+    """A person's own seed in a run of `seed`: the scripted person's is the run's (as with
+    one person), each other person's the run's and their name, so no two wander alike."""
     return seed if scripted else (seed + zlib.crc32(name.encode())) % 2**31

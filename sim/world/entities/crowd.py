@@ -15,7 +15,7 @@ import mujoco
 import numpy as np
 from highway_env.road.road import Road
 
-from sim.scenario.crowd_motion import people_tracks
+from sim.scenario.motion import people_tracks
 from sim.scenario.spec import Scenario
 from sim.world.entities.base import Entity
 from sim.world.entities.pedestrian import PedestrianBody
@@ -37,6 +37,6 @@ class CrowdDirector(Entity):
         """Nothing to draw: the members are bodies of their own."""
 
     def reset(self, road: Road, rng: np.random.Generator, seed: int) -> None:
-        tracks = people_tracks(self.scenario, seed, self.t_end)[len(self.scenario.planned) :]
-        for body, track in zip(self.members, tracks, strict=True):
-            body.follow(track)
+        tracks = people_tracks(self.scenario, seed, self.t_end)
+        for body in self.members:
+            body.follow(tracks[body.name])

@@ -18,7 +18,7 @@ from highway_env.road.road import Road
 from monopic.camera import CameraModel
 from sim.geometry.frames import Pose2D, wrap_angle
 from sim.geometry.polygons import rectangle
-from sim.scenario.path import walk_seed
+from sim.scenario.path import person_seed
 from sim.scenario.spec import MannequinSpec, PedestrianSpec
 from sim.scenario.track import Track
 from sim.world.body import PedestrianTruth, make_truth
@@ -93,7 +93,7 @@ class PedestrianBody(Entity):
         each other person's from the seed and their name, so no two wander alike."""
         if self.walk is None:
             raise RuntimeError(f"pedestrian {self.name!r} has no walk to start")
-        seed = walk_seed(seed, self.name, self.scripted)
+        seed = person_seed(seed, self.name, self.scripted)
         self.walker = Pedestrian(
             road, self.walk, self.gait, t_end=self.t_end, seed=seed, path=self.given_path
         )
