@@ -152,8 +152,13 @@ def crowd_tracks(s: Scenario, planned: Sequence[Track], seed: int, t_end: float)
     assert crowd is not None
     rng = np.random.default_rng([int(seed), SEED_TAG])
     street = street_of(s, crowd, planned, t_end)
-    area = walkable_area(s, crowd, street, planned, t_end)
-    sim = jps.Simulation(model=jps.CollisionFreeSpeedModelV2(), geometry=area, dt=DT)
+    area = walkable_area(s, crowd, street, planned, t_end, queue_crossing=False)
+    try:
+        sim = jps.Simulation(model=jps.CollisionFreeSpeedModelV2(), geometry=area, dt=DT)
+    except RuntimeError as err:  # e.g. parked cars cutting a pavement in two
+        raise UserError(
+            f"scenario {s.name!r}: crowd: JuPedSim refuses its street ({err})"
+        ) from None
 
     # The planned people: steered exactly along their Tracks.
     steer = sim.add_direct_steering_stage()
@@ -211,6 +216,9 @@ def crowd_tracks(s: Scenario, planned: Sequence[Track], seed: int, t_end: float)
         for agent_id, track in proxies:
             steer_along(sim, agent_id, track, sim.elapsed_time() + DT)
         if queue is not None and abs(sim.elapsed_time() - crowd.release) < DT / 2:
+            # The queue's way across opens when it is released: until then it keeps to
+            # the pavement, as people waiting at a kerb do.
+            sim.switch_geometry(walkable_area(s, crowd, street, planned, t_end))
             sim.get_stage(queue).state = jps.WaitingSetState.INACTIVE
         sim.iterate()
         if i % SAMPLE == 0:
@@ -224,15 +232,16 @@ def crowd_tracks(s: Scenario, planned: Sequence[Track], seed: int, t_end: float)
 
 
 def walkable_area(s: Scenario, crowd: Crowd, street: Street, planned: Sequence[Track],
-                  t_end: float):  # fmt: skip
-    """Pavements, the crossing strip and a corridor along each planned person's path over
-    the run, less the parked cars."""
+                  t_end: float, queue_crossing: bool = True):  # fmt: skip
+    """Pavements, the crossers' strip of road (which also joins the two pavements: JuPedSim
+    needs one connected area), the queue's strip (once it may cross) and a corridor along
+    each planned person's path over the run, less the parked cars."""
     import shapely
 
     pieces = [street.pavement(side, street.x0, street.x1, 0.0) for side in ("near", "far")]
     x0, x1 = crowd.cross_region
     pieces.append(shapely.box(x0, street.near[0], x1, street.far[1]))
-    if crowd.queue:
+    if crowd.queue and queue_crossing:
         x1 = crowd.queue_x + QUEUE_ROW * QUEUE_SPACING + 1.0
         pieces.append(shapely.box(crowd.queue_x - 1.0, street.near[0], x1, street.far[1]))
     times = np.arange(0.0, t_end + 2 * DT, 0.1)
