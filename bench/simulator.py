@@ -18,7 +18,16 @@ body) and, within the truth, the hidden share: `visibility()` (one mj_multiRay p
 and `occluded_landmarks` (33 mj_ray calls per person), each timed by a perf_counter wrapped
 around it in the child (`timed_parts`). `--people-only` runs that part alone.
 
-    .venv/bin/python -m bench.simulator [--frames 60] [--runs 6] [--people-only] [--no-append]
+And as a line of its own (benchmark `simulator_crowd`), the crowd model's cost: a crowd of
+5, 10 and 20 (scenarios/families/small/crowd/crowd_crossing.toml's, the scripted person
+beside it) worked out for a run of `--frames` frames (sim.scenario.crowd_motion.crowd_tracks,
+as a World's reset does once a run), split into JuPedSim's own steps (Simulation.iterate)
+and the rest (steering the planned people, reading positions, the members' Tracks); per
+frame at 15 fps, beside the frame a World renders with those people (World.step with
+rendering). `--crowd-only` runs that part alone.
+
+    .venv/bin/python -m bench.simulator [--frames 60] [--runs 6] [--people-only]
+        [--crowd-only] [--no-append]
 """
 
 from __future__ import annotations
@@ -46,6 +55,9 @@ TITLE = "Simulator: render time, scenario run on one core, sweep throughput"
 PEOPLE_TITLE = "Simulator: render and truth per frame with 1 to 20 people in view"
 PEOPLE = (1, 5, 10, 20)  # people in view: the scripted person and PEOPLE - 1 bystanders
 PEOPLE_STRETCH_X = 0.6  # the stretch goal: 10 people's frame rate over 1 person's
+CROWD_TITLE = "Simulator: the crowd model's time per frame with 5 to 20 people"
+CROWD_SIZES = (5, 10, 20)  # crowd members (along the pavements; 3 of them crossing)
+CROWD_FILE = ROOT / "scenarios/families/small/crowd/crowd_crossing.toml"
 WARM_STEPS = 2  # steps of each world not timed (the new scene's first draws)
 # The bystanders in the order they join (x, y, heading in degrees, speed in m/s), in the world
 # frame: the robot starts at the origin heading east (+x) at 2 m/s, the road is along x
@@ -222,6 +234,98 @@ def child_people(frames: int, counts: Sequence[int] = PEOPLE, rounds: int = 2) -
     res["rounds"] = rounds
     res["maxrss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     return res
+
+
+def crowd_scenario(members: int, frames: int) -> Any:
+    """crowd_crossing.toml's scenario with `members` in its crowd (3 crossing) and a run of
+    `frames` frames at 15 fps."""
+    from dataclasses import replace
+
+    from sim.scenario.crowd import crowd_looks
+    from sim.scenario.files import load
+
+    base = load(CROWD_FILE).scenario({}, "bench")
+    assert base.crowd is not None
+    across = min(3, members)
+    crowd = replace(base.crowd, along=members - across, across=across,
+                    looks=crowd_looks(members, 0.1))  # fmt: skip
+    return replace(base, crowd=crowd, duration=frames / REALTIME_FPS)
+
+
+def child_crowd(frames: int, sizes: Sequence[int] = CROWD_SIZES, rounds: int = 3) -> dict[str, Any]:
+    """Per crowd size: the crowd's Tracks for a run (median of `rounds`), JuPedSim's
+    iterate timed apart, and World.step with rendering of that crowd (p50, 20 frames)."""
+    import jupedsim
+    import numpy as np
+
+    from sim.scenario.crowd_motion import DT, crowd_tracks
+    from sim.scenario.motion import people_tracks
+    from sim.world.world import World
+
+    watch = Stopwatch()
+    res: dict[str, Any] = {}
+    with mock.patch.object(jupedsim.Simulation, "iterate", watch.wrap(jupedsim.Simulation.iterate)):
+        for n in sizes:
+            s = crowd_scenario(n, frames)
+            t_end = s.duration + 5.0  # a World's lookahead beyond the run, about
+            planned = list(people_tracks(replace_crowd(s), s.seed, t_end).values())
+            total, model = [], []
+            for r in range(rounds):
+                watch.reset()
+                t0 = time.perf_counter()
+                crowd_tracks(s, planned, r, t_end)
+                total.append(time.perf_counter() - t0)
+                model.append(watch.s)
+            frames_worked = t_end * REALTIME_FPS
+            steps = []
+            with World(s) as world:
+                world.reset()
+                for k in range(min(frames, 22) - 1):
+                    t0 = time.perf_counter()
+                    world.step()
+                    if k >= WARM_STEPS:
+                        steps.append(time.perf_counter() - t0)
+            res[str(n)] = {
+                "total_ms_per_frame": 1e3 * float(np.median(total)) / frames_worked,
+                "jupedsim_ms_per_frame": 1e3 * float(np.median(model)) / frames_worked,
+                "jupedsim_ms_per_iteration": 1e3 * float(np.median(model)) / (t_end / DT),
+                "world_step_p50_ms": 1e3 * float(np.percentile(steps, 50)),
+                "seconds_worked": t_end,
+            }
+    res["rounds"] = rounds
+    return res
+
+
+def replace_crowd(s: Any) -> Any:
+    """The scenario without its crowd (its planned people alone)."""
+    from dataclasses import replace
+
+    return replace(s, crowd=None)
+
+
+def crowd_report(got: dict[str, Any], frames: int) -> tuple[dict[str, Any], str]:
+    """The crowd child's figures as history results and a Markdown table."""
+    sizes = sorted(int(k) for k in got if k.isdigit())
+    lines = [
+        f"Crowd: {CROWD_FILE.relative_to(ROOT)} with 5-20 members and its scripted person, "
+        f"worked out for a run of {frames} frames and a World's lookahead (sim.scenario."
+        f"crowd_motion.crowd_tracks, once per run at reset), median of {got['rounds']}; "
+        "per frame at 15 fps. One core, the sweep workers' environment.",
+        "",
+        "| crowd | JuPedSim steps per frame | whole crowd model per frame | per JuPedSim step "
+        "| World.step with rendering (p50) | model / step |",
+        "| ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    for n in sizes:
+        r = got[str(n)]
+        lines.append(
+            f"| {n} | {r['jupedsim_ms_per_frame']:.2f} ms | {r['total_ms_per_frame']:.2f} ms "
+            f"| {r['jupedsim_ms_per_iteration']:.3f} ms | {r['world_step_p50_ms']:.0f} ms "
+            f"| {r['total_ms_per_frame'] / r['world_step_p50_ms']:.3f} |"
+        )
+    return {"frames": frames, "crowd": {k: v for k, v in got.items() if k.isdigit()}}, "\n".join(
+        lines
+    )
 
 
 def people_report(people: dict[str, Any], frames: int) -> tuple[dict[str, Any], str]:
@@ -418,7 +522,13 @@ def main() -> None:
         "--people-only", action="store_true",
         help="only the frame with 1 to 20 people in view (its own history line)",
     )  # fmt: skip
-    ap.add_argument("--child", choices=("render", "run", "sweep", "people"), help=argparse.SUPPRESS)
+    ap.add_argument(
+        "--crowd-only", action="store_true",
+        help="only the crowd model's time per frame with 5 to 20 people (its own history line)",
+    )  # fmt: skip
+    ap.add_argument(
+        "--child", choices=("render", "run", "sweep", "people", "crowd"), help=argparse.SUPPRESS
+    )
     ap.add_argument("--people", type=int, nargs="+", default=PEOPLE, help=argparse.SUPPRESS)
     ap.add_argument("--rounds", type=int, default=2, help=argparse.SUPPRESS)
     ap.add_argument("--pin", action="store_true", help=argparse.SUPPRESS)
@@ -435,6 +545,8 @@ def main() -> None:
             out = child_render(args.frames)
         elif args.child == "people":
             out = child_people(args.frames, args.people, args.rounds)
+        elif args.child == "crowd":
+            out = child_crowd(args.frames)
         elif args.child == "run":
             out = child_run(
                 args.frames, bool(args.ablation), bool(args.shadows), args.model, args.runtime
@@ -444,8 +556,15 @@ def main() -> None:
         print(json.dumps(out))
         return
 
-    if not args.people_only:
+    if not (args.people_only or args.crowd_only):
         main_rows(args)
+    if not args.people_only:
+        recorder = Recorder("simulator_crowd", CROWD_TITLE)
+        results, table = crowd_report(spawn_child("crowd", True, frames=args.frames), args.frames)
+        print(table)
+        recorder.finish(results, table, write=not args.no_append)
+    if args.crowd_only:
+        return
     recorder = Recorder("simulator_people", PEOPLE_TITLE)
     people = spawn_child("people", True, frames=args.frames)
     results, table = people_report(people, args.frames)

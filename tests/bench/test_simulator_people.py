@@ -75,3 +75,22 @@ def test_the_report_gives_the_ten_over_one_ratio_against_the_stretch_goal() -> N
     assert results["fps_10_over_1_x"] == pytest.approx(0.5)
     assert results["rows"][1]["shadow_pass_ms"] == pytest.approx(40.0)
     assert f"0.50 (stretch goal {simulator.PEOPLE_STRETCH_X:g}: not met)" in table
+
+
+def test_the_bench_crowd_has_the_members_asked_for_beside_the_scripted_person() -> None:
+    for n in simulator.CROWD_SIZES:
+        s = simulator.crowd_scenario(n, 30)
+        assert s.crowd is not None and s.crowd.count == n and len(s.people) == n + 1
+        assert s.frames == 30
+
+
+def test_the_crowd_table_gives_the_model_beside_the_rendered_frame() -> None:
+    got = {
+        "5": {"total_ms_per_frame": 1.0, "jupedsim_ms_per_frame": 0.5,
+              "jupedsim_ms_per_iteration": 0.05, "world_step_p50_ms": 100.0,
+              "seconds_worked": 9.0},
+        "rounds": 3,
+    }  # fmt: skip
+    results, table = simulator.crowd_report(got, 60)
+    assert results["crowd"]["5"]["world_step_p50_ms"] == 100.0
+    assert "| 5 | 0.50 ms | 1.00 ms | 0.050 ms | 100 ms | 0.010 |" in table
