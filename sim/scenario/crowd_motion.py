@@ -31,18 +31,29 @@ from sim.scenario.families import street_bounds
 from sim.scenario.path import person_seed
 from sim.scenario.spec import Crowd, Scenario
 from sim.scenario.track import Track
-from sim.scenario.walkers.human import intent_cues
+from sim.scenario.walkers.human import intent_cues, sines, strides, wander_tables
 
 DT = 0.01  # s, JuPedSim's step (its own examples' value)
 SAMPLE = 5  # steps between the Track's vertices (0.05 s)
-RADIUS = 0.25  # m, a person's radius to the model: the footprint's half side
+RADIUS = 0.2  # m, a person's radius to the model (JuPedSim's default: a body's half width)
 PROXY_RADIUS = 0.2  # m, a planned person's: they never move for the crowd
 SPACING = 0.8  # m, at least between two people's starts (JuPedSim refuses overlaps)
 KERB_MARGIN = 0.3  # m kept from the pavement's edges at the start
 SPEED_LIMITS = (0.6, 2.2)  # m/s, desired speeds drawn outside are clipped (Weidmann's span)
-GROUP_REACH = 2.0  # m, how far apart at the start two people of a group may be
+# The model's reach of neighbours' repulsion (JuPedSim's default), and a group's people's:
+# at the default, two people walking side by side drift apart to about 0.9 m; a group keeps
+# closer (dyads walk 0.6-0.8 m apart: Moussaid et al. 2010, PLoS ONE 5(4) e10047).
+NEIGHBOUR_RANGE = 0.1  # m
+GROUP_RANGE = 0.05  # m
+GROUP_GAP = 0.7  # m between people of a group walking side by side (shoulder to shoulder)
+GROUP_REACH = 1.5  # m: a group's people are within this of one another at the start
+THIRD_IN_GROUP = 0.3  # share of groups of three (the rest pairs)
 MARGIN = 30.0  # m of street beyond where anyone starts: nobody reaches its end in a run
-CAPACITY = 0.5  # people per square metre of their start area at most (the model's packing)
+# People per square metre of their start area at most, per part of the crowd: the walkers'
+# starts are drawn GROUP_SPACING apart (room for a group beside each), which random draws
+# fill at about 0.28 a square metre; the others' SPACING apart, about 1 a square metre.
+CAPACITY = {"along": 0.2, "across": 0.5, "queue": 0.5}
+GROUP_SPACING = 1.5  # m between the first people of the walkers' units
 QUEUE_SPACING = 0.7  # m between places in the queue, along and away from the kerb
 QUEUE_ROW = 3  # places per row at the kerb
 SETTING_OFF = 0.3  # m/s: above it a person walks (a start or a stop for the cues)
@@ -126,12 +137,12 @@ def capacity_problem(crowd: Crowd, s: Scenario) -> tuple[str, int, str] | None:
         if n == 0:
             continue
         area = start_room(crowd, street, role)
-        most = int(area * CAPACITY)
+        most = int(area * CAPACITY[role])
         if n > most:
             where = {"along": "region", "across": "cross_region", "queue": "queue_x"}[role]
             return role, n, (
                 f"the street holds at most {most} people there ({area:.0f} m2 of pavement "
-                f"at {CAPACITY:g} a square metre, set by crowd.{where}): fewer people or a "
+                f"at {CAPACITY[role]:g} a square metre, set by crowd.{where}): fewer people or a "
                 "longer stretch"
             )  # fmt: skip
     return None
@@ -173,30 +184,38 @@ def crowd_tracks(s: Scenario, planned: Sequence[Track], seed: int, t_end: float)
         )  # fmt: skip
         proxies.append((sim.add_agent(params), track))
 
-    # The crowd's starts, clear of the planned people's.
+    # The crowd's starts, clear of the planned people's: a group side by side.
     taken = shapely.union_all(
         [shapely.Point(t.state(0.0).position).buffer(SPACING) for t in planned]
     )
     starts: list[tuple[float, float]] = []
-    roles = [crowd.role(k) for k in range(crowd.count)]
+    groups: list[list[int]] = []
     for role in ("along", "across", "queue"):
-        n = roles.count(role)
-        if n:
-            free = start_area(crowd, street, role).difference(taken)
-            placed = distribute(jps, free, n, int(rng.integers(2**31)), role)
-            starts.extend(placed)
-            taken = taken.union(shapely.MultiPoint(placed).buffer(SPACING / 2))
+        n = getattr(crowd, role)
+        if not n:
+            continue
+        free = start_area(crowd, street, role).difference(taken)
+        sizes = group_sizes(n, crowd.groups, rng) if role == "along" else [1] * n
+        placed, units = place_units(jps, free, sizes, int(rng.integers(2**31)), role, rng)
+        groups += [[len(starts) + k for k in unit] for unit in units if len(unit) > 1]
+        starts.extend(placed)
+        taken = taken.union(shapely.MultiPoint(placed).buffer(SPACING / 2))
     speeds = np.clip(rng.normal(crowd.speed, crowd.speed_spread, crowd.count), *SPEED_LIMITS)
-    groups = form_groups(crowd, starts, street, rng)
     ways = np.where(rng.uniform(size=crowd.count) < 0.5, 1.0, -1.0)
     for group in groups:  # a group walks one way at one speed
         speeds[group] = speeds[group[0]]
         ways[group] = ways[group[0]]
+    # Each person's own slow wander of speed (the human walker's: cues.speed_wander of it
+    # over 3-12 s), so a group's people drift a little against one another, as people do.
+    names = [m.name for m in crowd.members()]
+    wander = [wander_tables(person_seed(seed, name, False))[0] for name in names]
 
     queue = None
     if crowd.queue:
         queue = sim.add_waiting_set_stage(queue_places(crowd, street))
     agents = []
+    roles = [crowd.role(k) for k in range(crowd.count)]
+    in_group = {k for group in groups for k in group}
     for k, (role, start) in enumerate(zip(roles, starts, strict=True)):
         stages = route(sim, crowd, street, role, start, ways[k], queue)
         journey = jps.JourneyDescription(stages)
@@ -205,6 +224,7 @@ def crowd_tracks(s: Scenario, planned: Sequence[Track], seed: int, t_end: float)
         params = jps.CollisionFreeSpeedModelV2AgentParameters(
             position=start, journey_id=sim.add_journey(journey), stage_id=stages[0],
             radius=RADIUS, desired_speed=float(speeds[k]),
+            range_neighbor_repulsion=GROUP_RANGE if k in in_group else NEIGHBOUR_RANGE,
         )  # fmt: skip
         agents.append(sim.add_agent(params))
 
@@ -213,6 +233,12 @@ def crowd_tracks(s: Scenario, planned: Sequence[Track], seed: int, t_end: float)
     headings = np.full((n_steps // SAMPLE + 1, crowd.count), np.nan)
     record(sim, agents, positions, headings, 0)
     for i in range(1, n_steps + 1):
+        if i % SAMPLE == 1:
+            t, walking = sim.elapsed_time(), alive(sim)
+            for k, agent_id in enumerate(agents):
+                if agent_id in walking:
+                    factor = 1 + crowd.cues.speed_wander * float(sines(wander[k], t))
+                    sim.agent(agent_id).model.desired_speed = float(speeds[k]) * factor
         for agent_id, track in proxies:
             steer_along(sim, agent_id, track, sim.elapsed_time() + DT)
         if queue is not None and abs(sim.elapsed_time() - crowd.release) < DT / 2:
@@ -224,9 +250,10 @@ def crowd_tracks(s: Scenario, planned: Sequence[Track], seed: int, t_end: float)
         if i % SAMPLE == 0:
             record(sim, agents, positions, headings, i // SAMPLE)
     times = np.arange(positions.shape[0]) * SAMPLE * DT
-    names = [m.name for m in crowd.members()]
     return [
-        member_track(crowd, times, positions[:, k], headings[:, k], person_seed(seed, name, False))
+        member_track(
+            crowd, k, times, positions[:, k], headings[:, k], person_seed(seed, name, False)
+        )
         for k, name in enumerate(names)
     ]
 
@@ -235,7 +262,7 @@ def walkable_area(s: Scenario, crowd: Crowd, street: Street, planned: Sequence[T
                   t_end: float, queue_crossing: bool = True):  # fmt: skip
     """Pavements, the crossers' strip of road (which also joins the two pavements: JuPedSim
     needs one connected area), the queue's strip (once it may cross) and a corridor along
-    each planned person's path over the run, less the parked cars."""
+    each planned person's path over the run (joined to a pavement), less the parked cars."""
     import shapely
 
     pieces = [street.pavement(side, street.x0, street.x1, 0.0) for side in ("near", "far")]
@@ -249,6 +276,11 @@ def walkable_area(s: Scenario, crowd: Crowd, street: Street, planned: Sequence[T
         line = track.positions_at(times)
         pieces.append(shapely.LineString(line).buffer(0.6) if len(np.unique(line, axis=0)) > 1
                       else shapely.Point(line[0]).buffer(0.6))  # fmt: skip
+        # Joined to the nearer pavement where it starts (someone standing on the road at
+        # the start: the model's area must be one piece).
+        x, y = line[0]
+        edge = street.near[1] if y - street.near[1] < street.far[0] - y else street.far[0]
+        pieces.append(shapely.box(x - 0.6, min(y, edge), x + 0.6, max(y, edge)))
     area = shapely.union_all(pieces)
     for car in s.scene.occluders:
         box = shapely.box(-car.length / 2, -car.width / 2, car.length / 2, car.width / 2)
@@ -257,9 +289,10 @@ def walkable_area(s: Scenario, crowd: Crowd, street: Street, planned: Sequence[T
     return area
 
 
-def distribute(jps, area, n: int, seed: int, role: str) -> list[tuple[float, float]]:
-    """n starts in `area`, SPACING apart and KERB_MARGIN from its edges (JuPedSim's own
-    sampler); a part of the crowd the area cannot hold is a UserError."""
+def distribute(jps, area, n: int, seed: int, role: str,
+               spacing: float = SPACING) -> list[tuple[float, float]]:  # fmt: skip
+    """n starts in `area`, `spacing` apart (JuPedSim's own sampler, over the area's parts by
+    their size); a part of the crowd the area cannot hold is a UserError."""
     import shapely
 
     polygon = area if isinstance(area, shapely.Polygon) else max(area.geoms, key=lambda g: g.area)
@@ -273,45 +306,67 @@ def distribute(jps, area, n: int, seed: int, role: str) -> list[tuple[float, flo
             continue
         try:
             out.extend(jps.distribute_by_number(
-                polygon=part, number_of_agents=int(count), distance_to_agents=SPACING,
+                polygon=part, number_of_agents=int(count), distance_to_agents=spacing,
                 distance_to_polygon=0.15, seed=seed, max_iterations=20_000,
             ))  # fmt: skip
         except Exception as err:  # JuPedSim's own errors: too many for the area
             raise UserError(
-                f"crowd.{role} = {n}: cannot place {count} people {SPACING:g} m apart in "
+                f"crowd.{role} = {n}: cannot place {count} people {spacing:g} m apart in "
                 f"{part.area:.0f} m2 ({err})"
             ) from None
     return [(float(x), float(y)) for x, y in out]
 
 
-def form_groups(crowd: Crowd, starts: Sequence[tuple[float, float]], street: Street,
-                rng: np.random.Generator) -> list[list[int]]:  # fmt: skip
-    """Groups of 2-3 among the people walking along, nearest neighbours on the same
-    pavement within GROUP_REACH, until `crowd.groups` of them are in one (or nobody is
-    near enough)."""
-    along = list(range(crowd.along))
-    want = round(crowd.groups * crowd.along)
-    free = set(along)
-    xy = np.array(starts[: crowd.along]).reshape(-1, 2)
-    groups: list[list[int]] = []
-    for k in rng.permutation(along):
-        if sum(map(len, groups)) >= want:
-            break
-        if k not in free:
-            continue
-        size = 3 if rng.uniform() < 0.3 else 2
-        side = xy[k, 1] > street.far[0] - 0.01
-        near = sorted(
-            (float(np.hypot(*(xy[j] - xy[k]))), j)
-            for j in free
-            if j != k and (xy[j, 1] > street.far[0] - 0.01) == side
-        )
-        mates = [j for d, j in near if d <= GROUP_REACH][: size - 1]
-        if mates:
-            group = [int(k), *mates]
-            groups.append(group)
-            free -= set(group)
-    return groups
+def group_sizes(n: int, share: float, rng: np.random.Generator) -> list[int]:
+    """n people as units in a random order: groups of 2 (or 3, THIRD_IN_GROUP of them) until
+    `share` of the people are in one, the rest alone."""
+    want = round(share * n)
+    sizes: list[int] = []
+    while sum(sizes) < want and n - sum(sizes) >= 2:
+        size = 3 if rng.uniform() < THIRD_IN_GROUP and n - sum(sizes) >= 3 else 2
+        sizes.append(size)
+    sizes += [1] * (n - sum(sizes))
+    return [int(k) for k in rng.permutation(np.array(sizes))]
+
+
+Starts = list[tuple[float, float]]
+
+
+def place_units(jps, area, sizes: Sequence[int], seed: int, role: str,
+                rng: np.random.Generator) -> tuple[Starts, list[list[int]]]:  # fmt: skip
+    """Starts for units of people in `area`: each unit's first person by JuPedSim's sampler
+    (the walkers' GROUP_SPACING apart, room for a group), the others of a group beside them
+    (GROUP_GAP across the pavement, else behind or ahead); a mate with no room left walks
+    alone from a place of their own. Returns the starts and each unit's indices."""
+    import shapely
+
+    spacing = GROUP_SPACING if role == "along" else SPACING
+    firsts = distribute(jps, area, len(sizes), seed, role, spacing=spacing)
+    starts: Starts = []
+    units: list[list[int]] = []
+    lonely = 0
+    for (x, y), size in zip(firsts, sizes, strict=True):
+        unit = [len(starts)]
+        starts.append((x, y))
+        side = 1.0 if rng.uniform() < 0.5 else -1.0
+        offsets = [(0.0, side), (0.0, -side), (-1.0, 0.0), (1.0, 0.0), (-1.0, side)]
+        for _ in range(size - 1):
+            for dx, dy in offsets:
+                p = (x + dx * GROUP_GAP, y + dy * GROUP_GAP)
+                clear = all(math.dist(p, q) >= 2 * RADIUS + 0.05 for q in starts)
+                if clear and area.contains(shapely.Point(p)):
+                    unit.append(len(starts))
+                    starts.append(p)
+                    break
+            else:
+                lonely += 1
+        units.append(unit)
+    if lonely:  # places of their own, clear of everyone placed
+        rest = area.difference(shapely.MultiPoint(starts).buffer(SPACING))
+        for p in distribute(jps, rest, lonely, seed + 1, role):
+            units.append([len(starts)])
+            starts.append(p)
+    return starts, units
 
 
 def route(sim, crowd: Crowd, street: Street, role: str, start: tuple[float, float],
@@ -352,6 +407,11 @@ def steer_along(sim, agent_id: int, track: Track, t: float) -> None:
     agent.model.desired_speed = float(np.hypot(*(want - here)) / DT)
 
 
+def alive(sim) -> set[int]:
+    """The ids of the agents still walking (an agent that reached its exit is gone)."""
+    return {a.id for a in sim.agents()}
+
+
 def record(sim, agents: Sequence[int], positions: np.ndarray, headings: np.ndarray,
            row: int) -> None:  # fmt: skip
     """Every member's position and heading now (a member who has left stays unrecorded:
@@ -365,27 +425,32 @@ def record(sim, agents: Sequence[int], positions: np.ndarray, headings: np.ndarr
             headings[row, k] = math.atan2(oy, ox)
 
 
-def member_track(crowd: Crowd, times: np.ndarray, xy: np.ndarray, heading: np.ndarray,
-                 seed: int) -> Track:  # fmt: skip
-    """A member's Track: the model's positions, facing where they walk (held while they
-    stand), with the human walker's cues (crowd.cues) at their starts, stops and every
-    check interval."""
+def member_track(crowd: Crowd, k: int, times: np.ndarray, xy: np.ndarray,
+                 heading: np.ndarray, seed: int) -> Track:  # fmt: skip
+    """Member k's Track: the model's positions with a human walker's stride (crowd.cues:
+    the body surges and sways with each step, as a human walker's does), facing where
+    they walk (held while they stand), with the human walker's cues at their starts, stops
+    and every check interval."""
     keep = ~np.isnan(xy[:, 0])
     last = int(np.flatnonzero(keep)[-1])
     xy, heading = xy.copy(), heading.copy()
     xy[last + 1 :] = xy[last]
     heading[last + 1 :] = heading[last]
     steps = np.diff(xy, axis=0)
-    speed = np.hypot(steps[:, 0], steps[:, 1]) / np.diff(times)
-    speeds = np.concatenate([[speed[0]], speed])  # the speed each vertex is reached at
+    arcs = np.concatenate([[0.0], np.cumsum(np.hypot(steps[:, 0], steps[:, 1]))])
+    speeds, phases, surge, sway = strides(crowd.cues, times, arcs, crowd.looks[k].height, seed)
     walking = speeds > SETTING_OFF
     # Piece k's heading: its step's while walking, else the model's facing (held).
+    speed = np.diff(arcs) / np.diff(times)
     ahead = np.arctan2(steps[:, 1], steps[:, 0])
     moving = np.concatenate([speed > SETTING_OFF, [False]])
-    yaw = np.where(moving, np.concatenate([ahead, ahead[-1:]]), heading)
+    line = np.where(moving, np.concatenate([ahead, ahead[-1:]]), heading)
+    forward = np.column_stack([np.cos(line), np.sin(line)])
+    left = np.column_stack([-forward[:, 1], forward[:, 0]])
+    points = xy + surge[:, None] * forward + sway[:, None] * left
     events: list[tuple[float, str]] = []
-    changes = np.flatnonzero(np.diff(walking.astype(int)))
-    for i in changes:
+    for i in np.flatnonzero(np.diff(walking.astype(int))):
         events.append((float(times[i + 1]), "set-off" if walking[i + 1] else "stop"))
-    head, torso = intent_cues(crowd.cues, times, yaw, speeds, events, seed)
-    return Track.from_vertices(times, xy, yaw, np.zeros(2), head_yaws=head, torso_yaws=torso)
+    head, torso = intent_cues(crowd.cues, times, line, speeds, events, seed)
+    return Track.from_vertices(times, points, line, np.zeros(2), footprint_yaws=line,
+                               phases=phases, head_yaws=head, torso_yaws=torso)  # fmt: skip

@@ -227,9 +227,9 @@ class Crowd:
     cross_region: tuple[float, float] = (8.0, 16.0)  # m, world x where people cross
     queue_x: float = 12.0  # m, world x of the queue's head at the near kerb
     release: float = 6.0  # s, when the queue crosses
-    groups: float = 0.3  # share of the people walking in groups of 2-3
+    groups: float = 0.5  # share of the walkers in groups of 2-3
     speed: float = 1.34  # m/s, mean desired speed
-    speed_spread: float = 0.26  # m/s, its standard deviation
+    speed_spread: float = 0.16  # m/s, its standard deviation in one street
     looks: tuple[MannequinSpec, ...] = ()  # one per member: along, across, then queue
     cues: HumanWalker = field(default_factory=HumanWalker)
     footprint: float = presets.FOOTPRINT  # m, each member's square on the ground

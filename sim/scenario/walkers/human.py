@@ -222,7 +222,7 @@ def _wander(rng: np.random.Generator, bounds: tuple[float, float]) -> np.ndarray
     return np.column_stack([periods, phases, weights / weights.sum()])
 
 
-def _sines(table: np.ndarray, x: np.ndarray) -> np.ndarray:
+def sines(table: np.ndarray, x: np.ndarray) -> np.ndarray:
     """The sum of the table's sinusoids at each x."""
     x = np.asarray(x, dtype=float)[..., None]
     return np.sum(table[:, 2] * np.sin(2 * math.pi * x / table[:, 0] + table[:, 1]), axis=-1)
@@ -237,7 +237,7 @@ class Walk:
 
     plan: list[Stretch]
     b: HumanWalker
-    speed_wander: np.ndarray  # _wander table, over time since setting off
+    speed_wander: np.ndarray  # a _wander table, over time since setting off
 
     def profile(self, t_start: float, s_start: float, t_end: float, until_s: float = math.inf):
         """(times, arc lengths, events) from setting off at `t_start` at arc length
@@ -256,7 +256,7 @@ class Walk:
         times, arcs = [t], [s]
         events: list[tuple[float, str]] = [(t_start, "set-off")]
         steps = max(1, math.ceil((t_end - t_start) / H))
-        wander = 1 + b.speed_wander * _sines(self.speed_wander, np.arange(steps + 1) * H)
+        wander = 1 + b.speed_wander * sines(self.speed_wander, np.arange(steps + 1) * H)
         for step in range(1, steps + 1):
             if s > until_s:
                 break
@@ -327,14 +327,14 @@ def set_off_time(b: HumanWalker, spec: Plan, seed: int) -> float:
     if spec.anchor is None:
         return first.time
     s_anchor = _arc_at(plan, spec.anchor.time)  # where the plan is then, along the route
-    walk = Walk(plan, b, _tables(seed)[0])
+    walk = Walk(plan, b, wander_tables(seed)[0])
     times, arcs, _ = walk.profile(0.0, 0.0, spec.anchor.time + 4 * b.start_time + 20.0, s_anchor)
     if not (0 < s_anchor <= arcs[-1]):
         return first.time
     return spec.anchor.time - float(np.interp(s_anchor, arcs, times))
 
 
-def _tables(seed: int) -> tuple[np.ndarray, np.ndarray]:
+def wander_tables(seed: int) -> tuple[np.ndarray, np.ndarray]:
     rng = np.random.default_rng([int(seed), 0x4855])  # "HU": the walker's own stream
     return _wander(rng, WANDER_PERIODS), _wander(rng, WANDER_WAVELENGTHS)
 
@@ -344,7 +344,7 @@ def human_track(b: HumanWalker, spec: Plan, t_end: float, seed: int, t_start: fl
     for name in ("start_time", "stop_time", "max_yaw_rate"):
         if not getattr(b, name) > 0:
             raise ValueError(f"behaviour.{name} must be > 0, got {getattr(b, name)}")
-    speed_table, line_table = _tables(seed)
+    speed_table, line_table = wander_tables(seed)
     plan = stretches(spec)
     walk = Walk(plan, b, speed_table)
     times, arcs, events = walk.profile(t_start, 0.0, t_end + H)
@@ -362,25 +362,12 @@ def human_track(b: HumanWalker, spec: Plan, t_end: float, seed: int, t_start: fl
     else:
         times = times - times[0]
     path = route(spec, plan, b.max_yaw_rate)
-    # Stride-level motion: the body surges twice a stride and sways once (the same phase
-    # drives the mannequin's legs), faded in as the walker gets going.
-    rng = np.random.default_rng([int(seed), 0x5354])  # "ST"
-    ds, dt = np.diff(arcs), np.diff(times)
-    # Each vertex's speed is the one it was reached at (so the vertex where a standing
-    # walker sets off is still where it stood); the first vertex's, the one it leaves at.
-    speeds = np.concatenate([[ds[0] / dt[0]], ds / dt]) if len(ds) else np.zeros(1)
-    steps_m = np.array([step_length(float(v), spec.looks.height) for v in speeds])
-    with np.errstate(divide="ignore", invalid="ignore"):
-        dphase = np.where(steps_m[1:] > 0, ds / (2 * steps_m[1:]), 0.0)
-    phases = float(rng.uniform()) + np.concatenate([[0.0], np.cumsum(dphase)])
-    going = np.clip(speeds / GOING, 0.0, 1.0)
-    surge = b.surge * steps_m / (2 * math.pi) * np.sin(4 * math.pi * phases) * going
-    sway = b.sway * np.sin(2 * math.pi * phases) * going
+    speeds, phases, surge, sway = strides(b, times, arcs, spec.looks.height, seed)
     base = np.empty((len(times), 2))
     tangents = np.empty(len(times))
     for k, s in enumerate(arcs):
         base[k], tangents[k] = path.point(float(s))
-    side = b.lateral_wander * _sines(line_table, arcs) + sway
+    side = b.lateral_wander * sines(line_table, arcs) + sway
     ahead = np.column_stack([np.cos(tangents), np.sin(tangents)])
     normal = np.column_stack([-ahead[:, 1], ahead[:, 0]])
     points = base + side[:, None] * normal + surge[:, None] * ahead
@@ -397,6 +384,27 @@ def human_track(b: HumanWalker, spec: Plan, t_end: float, seed: int, t_start: fl
         times, points, yaws, end, footprint_yaws=tangents, phases=phases, head_yaws=head,
         torso_yaws=torso,
     )  # fmt: skip
+
+
+def strides(b: HumanWalker, times: np.ndarray, arcs: np.ndarray, height: float, seed: int
+            ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:  # fmt: skip
+    """Stride-level motion along a walk (arc length `arcs` at `times`): each vertex's
+    speed, the stride phase, the body's surge (m ahead: twice a stride) and sway (m to the
+    left: once a stride), faded in as the walker gets going. The same phase drives the
+    mannequin's legs."""
+    rng = np.random.default_rng([int(seed), 0x5354])  # "ST"
+    ds, dt = np.diff(arcs), np.diff(times)
+    # Each vertex's speed is the one it was reached at (so the vertex where a standing
+    # walker sets off is still where it stood); the first vertex's, the one it leaves at.
+    speeds = np.concatenate([[ds[0] / dt[0]], ds / dt]) if len(ds) else np.zeros(1)
+    steps_m = np.array([step_length(float(v), height) for v in speeds])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dphase = np.where(steps_m[1:] > 0, ds / (2 * steps_m[1:]), 0.0)
+    phases = float(rng.uniform()) + np.concatenate([[0.0], np.cumsum(dphase)])
+    going = np.clip(speeds / GOING, 0.0, 1.0)
+    surge = b.surge * steps_m / (2 * math.pi) * np.sin(4 * math.pi * phases) * going
+    sway = b.sway * np.sin(2 * math.pi * phases) * going
+    return speeds, phases, surge, sway
 
 
 def _arc_at(plan: list[Stretch], t: float) -> float:
