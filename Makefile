@@ -47,15 +47,17 @@ format: $(STAMP)
 	$(BIN)/ruff check --fix .
 
 # Simulated walkers beside real ones (docs/realism/report.md): free walks and the medium
-# sweep's families, human and rail, against the ETH/UCY scenes shipped beside the project
-# (read at run time, never copied in), and the crowd section: the bystanders of
-# people-pavement among each other beside the scenes (density, nearest person, groups)
-# until crowd specs of matched density exist. A minute or two.
+# sweep's families, human and rail, and crowds at each real scene's density (JuPedSim;
+# scenarios/sweeps/crowd-hotel.toml, crowd-zara.toml), against the ETH/UCY scenes shipped
+# beside the project (read at run time, never copied in): per walker (speed, acceleration,
+# turning, constant-velocity error) and per crowd (density, nearest person, groups, speed
+# spread), with people-pavement's scripted bystanders beside them. A few minutes.
 REAL_TRACKS ?= ../shared/data/eth-ucy-calibration
+CROWDS := scenarios/sweeps/crowd-hotel.toml scenarios/sweeps/crowd-zara.toml
 realism: $(STAMP)
 	$(BIN)/monopic realism scenarios/sweeps/walks.toml scenarios/sweeps/walks-rail.toml \
 		scenarios/sweeps/medium-human.toml scenarios/sweeps/medium.toml \
-		--crowds scenarios/sweeps/people-pavement.toml \
+		--crowds $(CROWDS) scenarios/sweeps/people-pavement.toml \
 		--real $(REAL_TRACKS)/*.txt --out docs/realism --judge walks
 
 clean-venv:

@@ -205,9 +205,10 @@ def _g(value: float) -> str:
     return "0" if abs(value) < 1e-9 else f"{value:.3g}"
 
 
-def report_text(real: Sequence[Summary], simulated: Sequence[Summary], judged: str,
-                command: str, plot: str) -> str:  # fmt: skip
-    """The realism report (Markdown): a table of every set, the verdicts, the plot."""
+def report_text(real: Sequence[Summary], simulated: Sequence[Summary],
+                judged: Sequence[str], command: str, plot: str) -> str:  # fmt: skip
+    """The realism report (Markdown): a table of every set, the verdicts of each judged
+    set, the plot."""
     head = ["set", "tracks", "steps"] + [f"{LABELS[s]} p50 / p90" for s, _ in STATISTICS]
     lines = [
         "# Realism: simulated walkers beside real ones",
@@ -228,13 +229,12 @@ def report_text(real: Sequence[Summary], simulated: Sequence[Summary], judged: s
             cells = [f"{s.name} ({kind})", str(s.tracks), str(s.steps)]
             cells += [f"{_g(s.p50[k])} / {_g(s.p90[k])}" for k, _ in STATISTICS]
             lines.append("| " + " | ".join(cells) + " |")
-    chosen = next((s for s in simulated if s.name == judged), None)
-    if chosen is not None:
+    for chosen in (s for name in judged for s in simulated if s.name == name):
         verdicts = judge(real, chosen)
         inside = sum(v.inside for v in verdicts)
         lines += [
             "",
-            f"## `{judged}` against the real scenes' span",
+            f"## `{chosen.name}` against the real scenes' span",
             "",
             "The span of each statistic is the real scenes' min to max, widened by 20 % "
             "(min x 0.8 to max x 1.2).",
@@ -251,6 +251,28 @@ def report_text(real: Sequence[Summary], simulated: Sequence[Summary], judged: s
         ]
     lines += ["", f"![distributions]({plot})", ""]
     return "\n".join(lines)
+
+
+def walkers_text(real: Sequence[Summary], walkers: Sequence[Summary]) -> str:
+    """The per-walker statistics of the crowds' people beside the real scenes' span."""
+    lines = [
+        "",
+        "### The crowds' walkers, one by one",
+        "",
+        "Every person of each crowd spec's runs but the scripted one (whose walk is the "
+        "family's script, judged with the walker specs above) on the per-walker statistics "
+        "of 0.4 s steps, p50 / p90, and how many fall inside the real scenes' span (min x "
+        "0.8 to max x 1.2).",
+        "",
+        "| set | tracks | " + " | ".join(LABELS[k] for k, _ in STATISTICS) + " | inside |",
+        "|" + " --- |" * (len(STATISTICS) + 3),
+    ]
+    for w in walkers:
+        verdicts = judge(real, w)
+        cells = [f"{_g(w.p50[k])} / {_g(w.p90[k])}" for k, _ in STATISTICS]
+        inside = f"{sum(v.inside for v in verdicts)} of {len(verdicts)}"
+        lines.append(f"| {w.name} | {w.tracks} | " + " | ".join(cells) + f" | {inside} |")
+    return "\n".join(lines) + "\n"
 
 
 def plot_distributions(real: Sequence[Summary], simulated: Sequence[Summary], path: Path,

@@ -19,7 +19,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         "(`frame person x y`, frames 10 apart, 0.4 s) on the same statistics: speed, "
         "|acceleration| and turn rate where walking, and the constant-velocity error at "
         "0.4, 0.8 and 1.2 s (p50 and p90). Writes DIR/report.md and DIR/distributions.png; "
-        "--judge names the set whose every p50 and p90 is checked against the real scenes' "
+        "--judge names the sets whose every p50 and p90 is checked against the real scenes' "
         "span (min to max, widened by 20 %). With --crowds, a crowd section too: each real "
         "scene's density (people per m2 of the ground its people walk), nearest-person "
         "distance, group speed difference, speed spread and group share beside each crowd "
@@ -40,7 +40,8 @@ def register(sub: argparse._SubParsersAction) -> None:
         metavar="DIR",
         help="folder for report.md and its plot (made as needed)",
     )
-    p.add_argument("--judge", help="the spec name to judge (default: the first spec's)")
+    p.add_argument("--judge", nargs="+", metavar="NAME",
+                   help="the spec names to judge (default: the first spec's)")  # fmt: skip
     p.set_defaults(func=run)
 
 
@@ -70,20 +71,21 @@ def run(args: argparse.Namespace) -> int:
         spec = load_spec(path)
         tracks = sweep_tracks(expand_spec(spec))
         simulated.append(summarise(TrackSet(spec.name, tuple(t.positions for t in tracks))))
-    judged = args.judge or (simulated[0].name if simulated else None)
-    if judged is not None and judged not in {s.name for s in simulated}:
-        names = ", ".join(s.name for s in simulated) or "none"
-        raise UserError(f"--judge {judged!r}: not one of the specs' names ({names})")
+    judged = args.judge or ([simulated[0].name] if simulated else [])
+    for name in judged:
+        if name not in {s.name for s in simulated}:
+            names = ", ".join(s.name for s in simulated) or "none"
+            raise UserError(f"--judge {name!r}: not one of the specs' names ({names})")
     crowd_text = _crowds(args) if args.crowds else ""
     args.out.mkdir(parents=True, exist_ok=True)
     command = "monopic realism " + " ".join(shlex.quote(a) for a in sys.argv[2:])
     plot_distributions(real, simulated, args.out / "distributions.png", "Walkers, 0.4 s steps")
-    text = report_text(real, simulated, judged or "", command, "distributions.png")
+    text = report_text(real, simulated, judged, command, "distributions.png")
     write_text_atomically(args.out / "report.md", text + crowd_text)
-    if judged is not None:
-        verdicts = judge(real, next(s for s in simulated if s.name == judged))
+    for name in judged:
+        verdicts = judge(real, next(s for s in simulated if s.name == name))
         inside = sum(v.inside for v in verdicts)
-        print(f"{judged}: {inside} of {len(verdicts)} statistics inside the real scenes' span")
+        print(f"{name}: {inside} of {len(verdicts)} statistics inside the real scenes' span")
         for v in verdicts:
             if not v.inside:
                 print(
@@ -97,8 +99,15 @@ def run(args: argparse.Namespace) -> int:
 def _crowds(args: argparse.Namespace) -> str:
     """The crowd section (and DIR/crowds.png), its figures printed as it goes."""
     from sim.analysis.crowd_stats import crowd_report_text, crowd_summary, judge_crowd, plot_crowds
-    from sim.analysis.realism import read_rows
-    from sim.analysis.tracks import run_rows
+    from sim.analysis.realism import (
+        TrackSet,
+        judge,
+        read_rows,
+        read_tracks,
+        summarise,
+        walkers_text,
+    )
+    from sim.analysis.tracks import run_rows, run_tracks
     from sim.runs.sweep import expand_spec, load_spec
 
     real = [crowd_summary(path.stem, [read_rows(path)]) for path in args.real]
@@ -110,10 +119,12 @@ def _crowds(args: argparse.Namespace) -> str:
             f"difference {v['group_speed_difference']:.3g} m/s, speed spread "
             f"{v['speed_spread']:.3g} m/s, group share {v['group_share']:.2f}"
         )
-    simulated = []
+    simulated, walkers = [], []
+    real_walkers = [summarise(read_tracks(path)) for path in args.real]
     for path in args.crowds:
         spec = load_spec(path)
-        s = crowd_summary(spec.name, [run_rows(run) for run in expand_spec(spec)])
+        runs = list(expand_spec(spec))
+        s = crowd_summary(spec.name, [run_rows(run) for run in runs])
         simulated.append(s)
         verdicts = judge_crowd(real, s)
         inside = sum(v.inside for v in verdicts)
@@ -124,6 +135,21 @@ def _crowds(args: argparse.Namespace) -> str:
         for v in verdicts:
             if not v.inside:
                 print(f"  outside: {v.stat} = {v.value:.3g} (span {v.low:.3g}-{v.high:.3g})")
+        # Its walkers: everyone but each run's scripted person (the family's script, judged
+        # with the walker specs), on the per-walker statistics.
+        tracks = [t for run in runs for t in run_tracks(run)[1:]]
+        walkers.append(summarise(TrackSet(spec.name, tuple(t.positions for t in tracks))))
+        verdicts = judge(real_walkers, walkers[-1])
+        inside = sum(v.inside for v in verdicts)
+        print(f"{s.name} (its walkers): {inside} of {len(verdicts)} per-walker statistics inside")
+        for v in verdicts:
+            if not v.inside:
+                print(f"  outside: {v.stat} {v.quantile} = {v.value:.3g} "
+                      f"(span {v.low:.3g}-{v.high:.3g})")  # fmt: skip
     args.out.mkdir(parents=True, exist_ok=True)
     plot_crowds(real, simulated, args.out / "crowds.png", "Crowds, 0.4 s frames")
-    return "\n" + crowd_report_text(real, simulated, "crowds.png")
+    return (
+        "\n"
+        + crowd_report_text(real, simulated, "crowds.png")
+        + walkers_text(real_walkers, walkers)
+    )

@@ -1,14 +1,16 @@
 """The crowd's motion: JuPedSim moves a scenario's crowd together, around everyone else.
 
-A crowd (sim.scenario.spec.Crowd) is walked by JuPedSim's collision-free speed model
-(Tordeux, Chraibi and Seyfried 2016; `CollisionFreeSpeedModelV2`, whose repulsion
-parameters are per agent): each person keeps a gap to the person ahead and turns away from
-neighbours and walls, so nobody walks through anybody. The walkable area is the street's
-pavements, a strip of road where people cross (`cross_region`) and a corridor along each
-planned person's path. The planned people (the scripted person and the bystanders, whose
-walks are their own walkers') are agents too, steered exactly along their Tracks (a direct
-steering stage, with no repulsion of their own): the crowd makes way for them, and they keep
-their meeting with the robot.
+A crowd (sim.scenario.spec.Crowd) is walked by JuPedSim's anticipation velocity model
+(Xu, Chraibi and Seyfried 2021, Transportation Research C 128, 103464: people perceive,
+predict where their neighbours will be and choose a way round, which reproduces
+bidirectional flows on a pavement; the collision-free speed model it extends jams there):
+each person keeps a gap to the person ahead and turns away from neighbours and walls, so
+nobody walks through anybody. The walkable area is the street's pavements, a strip of road
+where people cross (`cross_region`) and a corridor along each planned person's path. The
+planned people (the scripted person and the bystanders, whose walks are their own
+walkers') are agents too, steered exactly along their Tracks (a direct steering stage,
+with no repulsion or anticipation of their own): the crowd makes way for them, and they
+keep their meeting with the robot.
 
 The crowd does not see the robot: its people walk as they would beside a street (the run is
 open-loop, as every walker's is). Everything drawn per run (start places, ways, groups,
@@ -41,13 +43,17 @@ SPACING = 0.8  # m, at least between two people's starts (JuPedSim refuses overl
 KERB_MARGIN = 0.3  # m kept from the pavement's edges at the start
 SPEED_LIMITS = (0.6, 2.2)  # m/s, desired speeds drawn outside are clipped (Weidmann's span)
 # The model's reach of neighbours' repulsion (JuPedSim's default), and a group's people's:
-# at the default, two people walking side by side drift apart to about 0.9 m; a group keeps
+# at the default, two people walking side by side drift apart to about 0.85 m; a group keeps
 # closer (dyads walk 0.6-0.8 m apart: Moussaid et al. 2010, PLoS ONE 5(4) e10047).
 NEIGHBOUR_RANGE = 0.1  # m
 GROUP_RANGE = 0.05  # m
 GROUP_GAP = 0.7  # m between people of a group walking side by side (shoulder to shoulder)
 GROUP_REACH = 1.5  # m: a group's people are within this of one another at the start
 THIRD_IN_GROUP = 0.3  # share of groups of three (the rest pairs)
+# Of the people walking along a pavement, the share on the right half of their way: people
+# avoid to the right and form lanes by direction (Moussaid et al. 2009, Proc. R. Soc. B
+# 276, 2755; right-hand traffic).
+KEEP_RIGHT = 0.8
 MARGIN = 30.0  # m of street beyond where anyone starts: nobody reaches its end in a run
 # People per square metre of their start area at most, per part of the crowd: the walkers'
 # starts are drawn GROUP_SPACING apart (room for a group beside each), which random draws
@@ -165,7 +171,8 @@ def crowd_tracks(s: Scenario, planned: Sequence[Track], seed: int, t_end: float)
     street = street_of(s, crowd, planned, t_end)
     area = walkable_area(s, crowd, street, planned, t_end, queue_crossing=False)
     try:
-        sim = jps.Simulation(model=jps.CollisionFreeSpeedModelV2(), geometry=area, dt=DT)
+        model = jps.AnticipationVelocityModel(rng_seed=int(rng.integers(2**63)))
+        sim = jps.Simulation(model=model, geometry=area, dt=DT)
     except RuntimeError as err:  # e.g. parked cars cutting a pavement in two
         raise UserError(
             f"scenario {s.name!r}: crowd: JuPedSim refuses its street ({err})"
@@ -177,10 +184,11 @@ def crowd_tracks(s: Scenario, planned: Sequence[Track], seed: int, t_end: float)
     proxies = []
     for track in planned:
         x, y = track.state(0.0).position
-        params = jps.CollisionFreeSpeedModelV2AgentParameters(
+        params = jps.AnticipationVelocityModelAgentParameters(
             position=(float(x), float(y)), journey_id=steer_journey, stage_id=steer,
             radius=PROXY_RADIUS, desired_speed=0.0, time_gap=0.1,
-            strength_neighbor_repulsion=0.0, strength_geometry_repulsion=0.0,
+            strength_neighbor_repulsion=0.0, reaction_time=DT, anticipation_time=0.0,
+            wall_buffer_distance=0.0,
         )  # fmt: skip
         proxies.append((sim.add_agent(params), track))
 
@@ -201,7 +209,7 @@ def crowd_tracks(s: Scenario, planned: Sequence[Track], seed: int, t_end: float)
         starts.extend(placed)
         taken = taken.union(shapely.MultiPoint(placed).buffer(SPACING / 2))
     speeds = np.clip(rng.normal(crowd.speed, crowd.speed_spread, crowd.count), *SPEED_LIMITS)
-    ways = np.where(rng.uniform(size=crowd.count) < 0.5, 1.0, -1.0)
+    ways = np.array([keep_right_way(street, y, rng) for _, y in starts])
     for group in groups:  # a group walks one way at one speed
         speeds[group] = speeds[group[0]]
         ways[group] = ways[group[0]]
@@ -221,7 +229,7 @@ def crowd_tracks(s: Scenario, planned: Sequence[Track], seed: int, t_end: float)
         journey = jps.JourneyDescription(stages)
         for a, b in zip(stages, stages[1:], strict=False):
             journey.set_transition_for_stage(a, jps.Transition.create_fixed_transition(b))
-        params = jps.CollisionFreeSpeedModelV2AgentParameters(
+        params = jps.AnticipationVelocityModelAgentParameters(
             position=start, journey_id=sim.add_journey(journey), stage_id=stages[0],
             radius=RADIUS, desired_speed=float(speeds[k]),
             range_neighbor_repulsion=GROUP_RANGE if k in in_group else NEIGHBOUR_RANGE,
@@ -367,6 +375,16 @@ def place_units(jps, area, sizes: Sequence[int], seed: int, role: str,
             units.append([len(starts)])
             starts.append(p)
     return starts, units
+
+
+def keep_right_way(street: Street, y: float, rng: np.random.Generator) -> float:
+    """Which way (+1 east, -1 west) someone walks along the pavement from a start at `y`:
+    most keep to the right of their way (KEEP_RIGHT of them), so a pavement's two flows
+    use its two halves and meet side by side, not head on."""
+    pavement = street.far if y > street.far[0] - 0.01 else street.near
+    east_half = y < (pavement[0] + pavement[1]) / 2  # the right of an eastward walker
+    keep = rng.uniform() < KEEP_RIGHT
+    return 1.0 if east_half == keep else -1.0
 
 
 def route(sim, crowd: Crowd, street: Street, role: str, start: tuple[float, float],

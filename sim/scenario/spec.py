@@ -227,7 +227,7 @@ class Crowd:
     cross_region: tuple[float, float] = (8.0, 16.0)  # m, world x where people cross
     queue_x: float = 12.0  # m, world x of the queue's head at the near kerb
     release: float = 6.0  # s, when the queue crosses
-    groups: float = 0.5  # share of the walkers in groups of 2-3
+    groups: float = 0.7  # share of the walkers in groups of 2-3 (Moussaid et al. 2010: up to 70 %)
     speed: float = 1.34  # m/s, mean desired speed
     speed_spread: float = 0.16  # m/s, its standard deviation in one street
     looks: tuple[MannequinSpec, ...] = ()  # one per member: along, across, then queue

@@ -142,9 +142,9 @@ def test_a_crowd_larger_than_its_pavement_is_one_line(tmp_path: Path) -> None:
 @pytest.mark.parametrize(
     ("old", "new", "field"),
     [
-        ("groups = 0.5", "groups = 1.5", "crowd.groups"),
+        ("groups = 0.7", "groups = 1.5", "crowd.groups"),
         ("region = [-2.0, 30.0]", "region = [30.0, -2.0]", "crowd.region"),
-        ("groups = 0.5", "grups = 0.5", "crowd.grups"),
+        ("groups = 0.7", "grups = 0.7", "crowd.grups"),
         ("across = 3", "across = -1", "crowd.across"),
     ],
 )
