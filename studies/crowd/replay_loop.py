@@ -149,8 +149,8 @@ class Scorer(Listener):
         truth = frame.truth
         for p in truth.people:
             self._history.setdefault(p.name, []).append(np.array(p.position_world, float))
-        result = frame.results[self.board]
-        sightings = result.people if isinstance(result, FrameResult) else ()
+        result: FrameResult | None = frame.results[self.board]
+        sightings = result.people if result is not None else ()
         candidates = [
             p for p in truth.people
             if p.in_frame and np.all(np.isfinite(p.box))
@@ -350,7 +350,7 @@ def report(lines: Sequence[Mapping[str, object]], command: str) -> str:
         command,
         "```",
         "",
-        f"Runs (family/robot speed/frames): {runs}.",
+        f"Runs (family/robot speed/frames): {runs}. The recordings are read from {TRACKS}.",
         "",
         "Each run renders a replay family (scenarios/families/small/crowd/replay_*.toml: "
         "real ETH/UCY walkers on the street) and feeds every frame, with the robot's own "
@@ -406,8 +406,6 @@ def main(argv: Sequence[str] | None = None) -> None:
         "--threads", type=int, default=1, help="onnxruntime threads (>= 1; default 1)"
     )
     args = parser.parse_args(argv)
-    if not (TRACKS / "biwi_hotel.txt").is_file():
-        parser.exit(2, f"the ETH/UCY tracks are not at {TRACKS} (set MONOPIC_SHARED_DATA)\n")
     for speed in args.speeds:
         if not 0 <= speed <= 5:
             parser.error(f"--speeds {speed:g}: must lie in [0, 5] m/s")
@@ -415,6 +413,8 @@ def main(argv: Sequence[str] | None = None) -> None:
         parser.error(f"--frames {args.frames}: must be >= 1")
     if args.threads < 1:
         parser.error(f"--threads {args.threads}: must be >= 1")
+    if not (TRACKS / "biwi_hotel.txt").is_file():
+        parser.exit(2, f"the ETH/UCY tracks are not at {TRACKS} (set MONOPIC_SHARED_DATA)\n")
     args.out.mkdir(parents=True, exist_ok=True)
     results = args.out / RESULTS
     done = {str(line["key"]) for line in read_results(results)}
@@ -429,7 +429,9 @@ def main(argv: Sequence[str] | None = None) -> None:
     wanted = {RunKey(f, s, args.frames).text for f in args.families for s in args.speeds}
     lines = [line for line in read_results(results) if line["key"] in wanted]
     given = list(argv) if argv is not None else sys.argv[1:]
-    command = " ".join([".venv/bin/python -m studies.crowd.replay_loop", *given])
+    shared = os.environ.get("MONOPIC_SHARED_DATA")
+    where = [f"MONOPIC_SHARED_DATA={shared}"] if shared else []
+    command = " ".join([*where, ".venv/bin/python -m studies.crowd.replay_loop", *given])
     text = report(lines, command)
     with atomic_path(args.out / REPORT) as tmp:
         tmp.write_text(text)
