@@ -1,7 +1,11 @@
 """A montage of the several-people families as the robot's camera sees them, each person
 boxed and named from the ground truth.
 
-    python -m tools.people_montage [--out docs/people/montage.png]
+    python -m tools.people_montage [--set people|crowd] [--out PNG]
+
+`--set crowd` draws the crowd families instead (scenarios/families/small/crowd/: the
+JuPedSim crowds and the replayed real scenes, which read the shared data) into
+docs/crowd/montage.png.
 
 One row per family, two frames each (an early one and one closer to the step out, the
 hiding or the robot passing): a small collision family with four bystanders on the
@@ -135,6 +139,19 @@ def tile(image_rgb: np.ndarray, people: tuple[PersonTruth, ...], caption: str) -
     return np.vstack([bar, frame])
 
 
+CROWD_ROWS = (
+    Row("crowd-crossing: 15 people moved by JuPedSim, one crossing into the robot's path",
+        "families/small/crowd/crowd_crossing.toml", (0.5, 3.0), {"robot.speed": 2.0}),
+    Row("kerb-queue: one steps out from a queue of five at the near kerb, the rest wait",
+        "families/small/crowd/kerb_queue.toml", (1.0, 3.5), {"crowd.queue": 5}),
+    Row("replay-hotel: 17 real walkers of the ETH hotel scene on the street (their recorded walks)",
+        "families/small/crowd/replay_hotel.toml", (0.5, 4.0)),
+    Row("replay-zara: 18 real walkers of the UCY zara01 scene, turned to cross the road",
+        "families/small/crowd/replay_zara.toml", (0.5, 3.5)),
+)  # fmt: skip
+SETS = {"people": (ROWS, "people"), "crowd": (CROWD_ROWS, "crowd")}
+
+
 def render_row(row: Row) -> np.ndarray:
     """The row's title over its two frames side by side."""
     f = load(SCENARIOS / row.file)
@@ -172,9 +189,12 @@ def write_png(path: Path, image: np.ndarray) -> None:
 
 def main(argv: list[str] | None = None) -> None:
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    ap.add_argument("--out", type=Path, default=ROOT / "docs" / "people" / "montage.png")
+    ap.add_argument("--set", choices=tuple(SETS), default="people", help="which families")
+    ap.add_argument("--out", type=Path, help="the PNG (default docs/<set>/montage.png)")
     args = ap.parse_args(argv)
-    rows = [render_row(row) for row in ROWS]
+    chosen, folder = SETS[args.set]
+    args.out = args.out or ROOT / "docs" / folder / "montage.png"
+    rows = [render_row(row) for row in chosen]
     gap = np.full((6, rows[0].shape[1], 3), 255, np.uint8)
     montage = np.vstack([part for row in rows for part in (row, gap)][:-1])
     write_png(args.out, montage)

@@ -165,3 +165,16 @@ def test_the_world_walks_the_crowd_it_works_out() -> None:
         for person in truth.people:
             want = tracks[person.name].state(world.time).position
             assert np.allclose(person.position_world, want, atol=1e-9)
+
+
+def test_the_readme_gives_the_crowds_defaults() -> None:
+    from sim.scenario.spec import Crowd
+    from tests.sim.test_presets import README, keyed, number, readme_tables
+
+    rows = keyed(readme_tables(README.read_text())["[crowd]"])
+    base = Crowd()
+    for key in ("along", "across", "queue", "release", "groups", "speed", "speed_spread"):
+        assert number(rows[key]["default"]) == pytest.approx(float(getattr(base, key))), key
+    s = scenario_of(CROSSING)
+    assert s.crowd is not None and s.crowd.speed == base.speed
+    assert sum(looks.height < 1.5 for looks in s.crowd.looks) == s.crowd.count // 10
