@@ -53,7 +53,15 @@ from pathlib import Path
 
 import numpy as np
 
-from sim.analysis.realism import FRAME_STEP, STEP, WALKING, Verdict, widened
+from sim.analysis.realism import (
+    FRAME_STEP,
+    STEP,
+    WALKING,
+    Verdict,
+    cdf_panel,
+    verdict_rows,
+    widened,
+)
 
 CELL = 1.0  # m, side of the squares of the walked region
 NEAR = 1.5  # m, at most this far apart to walk together
@@ -342,11 +350,7 @@ def crowd_report_text(real: Sequence[CrowdSummary], simulated: Sequence[CrowdSum
             "| --- | --- | ---: | --- | --- |",
         ]
         labels = {k: label for k, label, _ in CROWD_STATISTICS}
-        lines += [
-            f"| {labels[v.stat]} | {v.quantile} | {_g(v.value)} | {_g(v.low)} - {_g(v.high)} "
-            f"| {'yes' if v.inside else 'no'} |"
-            for v in verdicts
-        ]
+        lines += verdict_rows(verdicts, labels)
     lines += ["", f"![crowds]({plot})", ""]
     return "\n".join(lines)
 
@@ -366,19 +370,9 @@ def plot_crowds(real: Sequence[CrowdSummary], simulated: Sequence[CrowdSummary],
     )
     for i, (attr, xlabel, ylabel) in enumerate(panels):
         ax = fig.add_subplot(1, 2, i + 1)
-        sets = [(s, "-") for s in real] + [(s, "--") for s in simulated]
-        for s, style in sets:
-            v = np.sort(getattr(s, attr))
-            if len(v):
-                ax.plot(v, np.arange(1, len(v) + 1) / len(v), style, label=s.name, lw=1.4)
-        ax.set_xlabel(xlabel)
-        ax.set_ylabel(ylabel)
-        ax.grid(alpha=0.3)
-        high = max((np.percentile(getattr(s, attr), 98) for s, _ in sets
-                    if len(getattr(s, attr))), default=1.0)  # fmt: skip
-        ax.set_xlim(0, high * 1.1 if high > 0 else 1.0)
-        if i == 0:
-            ax.legend(fontsize=7, loc="lower right")
+        curves = [(s.name, getattr(s, attr), style) for group, style in ((real, "-"),
+                  (simulated, "--")) for s in group]  # fmt: skip
+        cdf_panel(ax, curves, xlabel, ylabel, legend=i == 0)
     fig.suptitle(title + " (solid: real scenes, dashed: simulated)", fontsize=10)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=100, format="png")

@@ -17,14 +17,14 @@ walker walks (speed > WALKING on the steps involved), p50 and p90.
 from __future__ import annotations
 
 import math
-import warnings
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
-from monopic.errors import UserError
+from sim.scenario.track_file import read_rows as track_rows
 
 STEP = 0.4  # s between positions
 FRAME_STEP = 10  # ETH/UCY frame numbers between consecutive positions
@@ -61,21 +61,9 @@ class Summary:
 def read_rows(path: Path) -> np.ndarray:
     """An ETH/UCY text file's rows as they are: an (n, 4) array of frame, person, x, y
     (frame numbers FRAME_STEP apart per STEP seconds; ids and frames kept, for what needs
-    who stood where at the same moment)."""
-    try:
-        with warnings.catch_warnings():  # an empty file: said below, in one line
-            warnings.simplefilter("ignore", UserWarning)
-            rows = np.loadtxt(path, ndmin=2)
-    except (OSError, ValueError) as err:
-        raise UserError(f"{path}: not a track file of `frame person x y` rows ({err})") from None
-    if rows.size == 0:
-        raise UserError(f"{path}: no rows (expected `frame person x y` rows)")
-    if rows.shape[1] != 4:
-        raise UserError(f"{path}: rows have {rows.shape[1]} columns, expected frame person x y")
-    if not np.all(np.isfinite(rows)):
-        bad = int(np.flatnonzero(~np.all(np.isfinite(rows), axis=1))[0])
-        raise UserError(f"{path}: row {bad + 1} is not finite ({' '.join(map(str, rows[bad]))})")
-    return rows
+    who stood where at the same moment). The replay walker's reader checks them
+    (sim.scenario.track_file.read_rows); gaps are the statistics' own to cut."""
+    return track_rows(path)
 
 
 def read_tracks(path: Path) -> TrackSet:
@@ -201,8 +189,19 @@ def judge(real: Sequence[Summary], simulated: Summary, widen: float = 0.2) -> li
 
 
 def _g(value: float) -> str:
-    """Three significant digits; rounding noise (a straight walk's 1e-15) as 0."""
+    """Three significant digits; rounding noise (a straight walk's 1e-15) as 0; none as -."""
+    if math.isnan(value):
+        return "-"
     return "0" if abs(value) < 1e-9 else f"{value:.3g}"
+
+
+def verdict_rows(verdicts: Sequence[Verdict], labels: Mapping[str, str]) -> list[str]:
+    """A verdict table's rows: statistic, quantile, value, span, inside."""
+    return [
+        f"| {labels[v.stat]} | {v.quantile} | {_g(v.value)} | {_g(v.low)} - {_g(v.high)} "
+        f"| {'yes' if v.inside else 'no'} |"
+        for v in verdicts
+    ]
 
 
 def report_text(real: Sequence[Summary], simulated: Sequence[Summary],
@@ -244,11 +243,7 @@ def report_text(real: Sequence[Summary], simulated: Sequence[Summary],
             "| statistic | quantile | simulated | span | inside |",
             "| --- | --- | ---: | --- | --- |",
         ]
-        lines += [
-            f"| {LABELS[v.stat]} | {v.quantile} | {_g(v.value)} | {_g(v.low)} - {_g(v.high)} "
-            f"| {'yes' if v.inside else 'no'} |"
-            for v in verdicts
-        ]
+        lines += verdict_rows(verdicts, LABELS)
     lines += ["", f"![distributions]({plot})", ""]
     return "\n".join(lines)
 
@@ -275,6 +270,23 @@ def walkers_text(real: Sequence[Summary], walkers: Sequence[Summary]) -> str:
     return "\n".join(lines) + "\n"
 
 
+def cdf_panel(ax: Any, curves: Sequence[tuple[str, np.ndarray, str]], xlabel: str,
+              ylabel: str, legend: bool) -> None:  # fmt: skip
+    """One panel of cumulative shares: each (name, values, line style) a curve, the x axis
+    from 0 to past the highest set's 98th percentile."""
+    for name, values, style in curves:
+        v = np.sort(values)
+        if len(v):
+            ax.plot(v, np.arange(1, len(v) + 1) / len(v), style, label=name, lw=1.4)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.grid(alpha=0.3)
+    high = max((np.percentile(v, 98) for _, v, _ in curves if len(v)), default=1.0)
+    ax.set_xlim(0, high * 1.1 if high > 0 else 1.0)
+    if legend:
+        ax.legend(fontsize=7, loc="lower right")
+
+
 def plot_distributions(real: Sequence[Summary], simulated: Sequence[Summary], path: Path,
                        title: str) -> None:  # fmt: skip
     """One panel per statistic: the share of steps within each value, every set a curve."""
@@ -285,18 +297,9 @@ def plot_distributions(real: Sequence[Summary], simulated: Sequence[Summary], pa
     fig = Figure(figsize=(13, 7.5), layout="constrained")
     for i, (stat, _) in enumerate(STATISTICS):
         ax = fig.add_subplot(2, 3, i + 1)
-        for s, style in [(s, "-") for s in real] + [(s, "--") for s in simulated]:
-            v = np.sort(s.values[stat])
-            if len(v):
-                ax.plot(v, np.arange(1, len(v) + 1) / len(v), style, label=s.name, lw=1.4)
-        ax.set_xlabel(LABELS[stat])
-        ax.set_ylabel("share of steps within")
-        ax.grid(alpha=0.3)
-        high = max((np.percentile(s.values[stat], 98) for s in (*real, *simulated)
-                    if len(s.values[stat])), default=1.0)  # fmt: skip
-        ax.set_xlim(0, high * 1.1 if high > 0 else 1.0)
-        if i == 0:
-            ax.legend(fontsize=7, loc="lower right")
+        curves = [(s.name, s.values[stat], style) for group, style in ((real, "-"),
+                  (simulated, "--")) for s in group]  # fmt: skip
+        cdf_panel(ax, curves, LABELS[stat], "share of steps within", legend=i == 0)
     fig.suptitle(title + " (solid: real scenes, dashed: simulated)", fontsize=10)
     with atomic_path(path) as tmp:
         fig.savefig(tmp, dpi=100, format="png")

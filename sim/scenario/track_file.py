@@ -17,6 +17,7 @@ from __future__ import annotations
 import functools
 import math
 import os
+import warnings
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -88,20 +89,29 @@ def read_track_file(path: Path) -> TrackFile:
     return _read(path.resolve(), mtime)
 
 
-@functools.lru_cache(maxsize=16)
-def _read(path: Path, mtime: int) -> TrackFile:
-    """The file as it was at `mtime` (the key that makes the cache see an edit)."""
+def read_rows(path: Path) -> np.ndarray:
+    """A track file's rows as they are: an (n, 4) array of frame, person, x, y, at least
+    one row, every value finite (else one UserError line naming the file and the row)."""
     try:
-        rows = np.loadtxt(path, ndmin=2)
+        with warnings.catch_warnings():  # an empty file: said below, in one line
+            warnings.simplefilter("ignore", UserWarning)
+            rows = np.loadtxt(path, ndmin=2)
     except (OSError, ValueError) as err:
         raise UserError(f"{path}: not a track file of `frame person x y` rows ({err})") from None
     if rows.size == 0:
-        raise UserError(f"{path}: no rows (expected `frame person x y`)")
+        raise UserError(f"{path}: no rows (expected `frame person x y` rows)")
     if rows.shape[1] != 4:
         raise UserError(f"{path}: rows have {rows.shape[1]} columns, expected frame person x y")
     if not np.all(np.isfinite(rows)):
-        row = int(np.flatnonzero(~np.all(np.isfinite(rows), axis=1))[0])
-        raise UserError(f"{path}: row {row + 1} holds a value that is not a finite number")
+        bad = int(np.flatnonzero(~np.all(np.isfinite(rows), axis=1))[0])
+        raise UserError(f"{path}: row {bad + 1} is not finite ({' '.join(map(str, rows[bad]))})")
+    return rows
+
+
+@functools.lru_cache(maxsize=16)
+def _read(path: Path, mtime: int) -> TrackFile:
+    """The file as it was at `mtime` (the key that makes the cache see an edit)."""
+    rows = read_rows(path)
     for column, what in ((0, "frame"), (1, "person id")):
         whole = rows[:, column] == np.round(rows[:, column])
         if not whole.all():
