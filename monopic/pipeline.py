@@ -273,7 +273,7 @@ class Pipeline:
         for pid in [pid for pid in self._extractors if pid not in present]:
             del self._extractors[pid]  # gone: an identity never comes back
             self._last.pop(pid, None)
-        worst = _worst(people)
+        worst = worst_for(people, self.primary)
         pose = PoseResult(
             worst.pose if worst is not None else None,
             seen.detector_runs,
@@ -290,13 +290,17 @@ class Pipeline:
 RISK_ORDER = {Risk.GREEN: 0, Risk.YELLOW: 1, Risk.RED: 2}
 
 
-def _worst(people: list[PersonResult]) -> PersonResult | None:
-    """The person whose warning is the robot's: the highest risk, then the soonest
-    collision, then a fresh decision over a carried one; people without any decision
-    only when no one has one (then the first seen with a pose)."""
+def worst_for(people: Sequence[PersonResult], key: str) -> PersonResult | None:
+    """The person whose warning by predictor `key` is the robot's: the highest risk, then
+    the soonest collision, then a fresh decision over a carried one; people without that
+    predictor's decision only when no one has one (then the first seen with a pose).
+
+    The pipeline's robot warning is the primary predictor's worst person; each other
+    predictor's robot warning is its own worst person (how sweeps compare predictors)."""
 
     def rank(p: PersonResult) -> tuple:
-        w = p.warning
+        d = p.decision(key)
+        w = d.warning if d is not None else None
         ttc = w.time_to_contact if w is not None and w.time_to_contact is not None else np.inf
         return (w is not None, RISK_ORDER[w.risk] if w else -1, -ttc, p.fresh, p.pose is not None)
 

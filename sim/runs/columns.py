@@ -12,9 +12,15 @@ from typing import Any
 
 import numpy as np
 
-from monopic.pipeline import FrameResult
+from monopic.pipeline import Decision, FrameResult, worst_for
 from sim.runs.loop import Listener, LoopFrame
-from sim.runs.result import DecisionColumns, PersonColumns, PipelineColumns, TruthColumns
+from sim.runs.result import (
+    DecisionColumns,
+    PersonColumns,
+    PipelineColumns,
+    TrackColumns,
+    TruthColumns,
+)
 from sim.world.ground_truth import GroundTruth
 
 STAGES = ("pose", "detect", "landmarks", "features", "predict", "warning", "total")
@@ -43,10 +49,13 @@ class TruthRecorder(Listener):
     columns: TruthColumns = field(default_factory=TruthColumns)
     people: list[PersonColumns] = field(default_factory=list)
     first_threat: str | None = None
+    # Every person's columns even with one person: the people tracker's warnings are
+    # matched to people by their boxes (sim.analysis.people).
+    every_person: bool = False
 
     def frame(self, frame: LoopFrame) -> None:
         self.add(frame.truth)
-        if len(frame.truth.people) > 1:
+        if len(frame.truth.people) > 1 or self.every_person:
             self.add_people(frame.truth)
 
     def add_people(self, truth: GroundTruth) -> None:
@@ -104,6 +113,9 @@ class PipelineRecorder(Listener):
     columns: PipelineColumns = field(default_factory=PipelineColumns)
     ms: dict[str, list[float | None]] = field(default_factory=lambda: {s: [] for s in STAGES})
     frames: int = 0
+    # Set for a pipeline with the people tracker: its tracks, and each predictor's
+    # columns are those of that predictor's worst person (monopic.pipeline.worst_for).
+    tracks: TrackColumns | None = None
 
     def frame(self, frame: LoopFrame) -> None:
         self.add(frame.results.get(self.pipeline))
@@ -121,7 +133,7 @@ class PipelineRecorder(Listener):
         for stage in STAGES:
             ms = result.stage_ms.get(stage) if result is not None else None
             self.ms[stage].append(rounded(ms, 2))
-        for d in result.decisions if result is not None else ():
+        for d in self._decisions(result):
             cols = c.decisions.setdefault(d.predictor, DecisionColumns())
             for col in _columns(cols):  # frames before this predictor's first decision
                 col.extend([None] * (k - len(col)))
@@ -134,6 +146,31 @@ class PipelineRecorder(Listener):
                 cols.intent.extend([None] * (k - len(cols.intent)))
                 cols.intent.append(d.prediction.intent)
 
+    def _decisions(self, result: FrameResult | None) -> list[Decision]:
+        """The robot's decision per predictor; with the people tracker, each predictor's
+        worst person's, whose identity goes into the track columns."""
+        if result is None:
+            if self.tracks is not None:
+                self.tracks.boxes.append([])
+            return []
+        if self.tracks is None:
+            return list(result.decisions)
+        self.tracks.boxes.append(
+            [[p.person_id, *(rounded(v, 1) for v in p.box)] for p in result.people]
+        )
+        keys = list(dict.fromkeys(d.predictor for p in result.people for d in p.decisions))
+        decisions = []
+        for key in keys:
+            person = worst_for(result.people, key)
+            d = person.decision(key) if person is not None else None
+            if d is None:
+                continue
+            column = self.tracks.warned_for.setdefault(key, [])
+            column.extend([None] * (self.frames - 1 - len(column)))
+            column.append(person.person_id if d.warning.collision else None)  # type: ignore[union-attr]
+            decisions.append(d)
+        return decisions
+
     def finished(self) -> PipelineColumns:
         """The columns, every predictor's padded to the frames run."""
         for cols in self.columns.decisions.values():
@@ -141,6 +178,9 @@ class PipelineRecorder(Listener):
                 col.extend([None] * (self.frames - len(col)))
             if cols.intent:
                 cols.intent.extend([None] * (self.frames - len(cols.intent)))
+        if self.tracks is not None:
+            for column in self.tracks.warned_for.values():
+                column.extend([None] * (self.frames - len(column)))
         return self.columns
 
 

@@ -29,8 +29,8 @@ from typing import Any
 from monopic.errors import UserError
 from sim.runs.result import ABLATION, RunResult, values_said
 from sim.runs.results_file import read_rows
-from sim.runs.run_spec import RunSpec
-from sim.runs.sweep import TREE_TAG, run_scenario, tree_digest
+from sim.runs.run_spec import ONE, RunSpec
+from sim.runs.sweep import PEOPLE_TAG, TREE_TAG, run_scenario, tree_digest
 from sim.scenario.files import ScenarioFile, load
 from sim.scenario.spec import Scenario
 
@@ -105,9 +105,12 @@ def find_line(results: Path, run_id: str) -> dict[str, Any]:
 
 
 def code_of(row: dict[str, Any]) -> str | None:
-    """The code version that ran a line, without the intent tree's digest."""
+    """The code version that ran a line, without the intent tree's digest or the people
+    tracker's tag."""
     code = row.get("code")
-    return code.partition(TREE_TAG)[0] if isinstance(code, str) and code else None
+    if not isinstance(code, str) or not code:
+        return None
+    return code.partition(TREE_TAG)[0].removesuffix(PEOPLE_TAG)
 
 
 # -- sweep lines ------------------------------------------------------------------------
@@ -200,6 +203,7 @@ def rebuild(row: RunResult, asked: Asked) -> RunSpec:
         record="all",
         record_file=str(asked.out),
         intent_tree=str(intent_tree_of(row, asked.results, asked.intent_tree) or ""),
+        tracker=row.tracker or ONE,
         code=row.code or "",
     )
 

@@ -15,10 +15,12 @@ Growing it (one rule for every growth: the lighting, several people, the camera)
 - A field that describes what only some runs have (several people) is written only on
   their lines (OPTIONAL, after ORDER's keys): a run without it writes the line it always
   wrote, and reads back with the default.
-- Several pedestrians: `truth` and each pipeline's columns stay the scripted person's (the
-  one the warnings are judged against); with several people `people` holds every
-  person's truth columns (the scripted one first) and `first_threat` names the person
-  first on a collision course.
+- Several pedestrians: `truth` stays the scripted person's; with several people `people`
+  holds every person's truth columns (the scripted one first) and `first_threat` names
+  the person first on a collision course. A pipeline's columns are the robot's warning
+  and the decision behind it (with the one-pedestrian tracker: its one person's; with
+  the people tracker, `tracker` = "everyone": each predictor's worst person's, whose
+  identity is in `tracks`).
 - SCHEMA goes up when a field is renamed, removed or changes meaning or units: lines of
   another schema are then refused with one line saying how to redo them, never read as
   if they meant the new thing.
@@ -125,6 +127,18 @@ class PipelineColumns:
 
 
 @dataclass
+class TrackColumns:
+    """What a pipeline with the people tracker saw and whom each predictor warned for,
+    per frame: the tracks' identities and boxes, and per predictor ('rules/image') the
+    identity of the person whose warning was the robot's (None: no warning). Matched to
+    the truth's people by sim.analysis.people, never by the pipeline."""
+
+    # Per frame, one [id, u0, v0, u1, v1] (px) per person the tracker reported.
+    boxes: list[list[list[float]]] = field(default_factory=list)
+    warned_for: dict[str, list[int | None]] = field(default_factory=dict)
+
+
+@dataclass
 class CameraSummary:
     width: int
     height: int
@@ -197,6 +211,12 @@ class RunResult:
     # on a collision course (None: nobody).
     people: list[PersonColumns] = field(default_factory=list)
     first_threat: str | None = None
+    # Runs whose pipelines follow everyone in view (OPTIONAL): the tracker, "everyone"
+    # ("" on lines of the one-pedestrian tracker, as every line before it), and each such
+    # pipeline's tracks and whom it warned for. Their `people` are written even with one
+    # person, so every warning can be matched to a person.
+    tracker: str = ""
+    tracks: dict[str, TrackColumns] = field(default_factory=dict)
 
     # JSON key order of a line (the fields above in the order lines have always had).
     ORDER = (
@@ -205,14 +225,16 @@ class RunResult:
     )  # fmt: skip
 
     # Keys written only on the lines of runs that have them (see "Growing it").
-    OPTIONAL = ("people", "first_threat")
+    OPTIONAL = ("people", "first_threat", "tracker", "tracks")
 
     def to_json(self) -> dict[str, Any]:
         """The line as JSON-ready data (plain dicts and lists)."""
         plain = to_plain(self)
         line = {k: plain[k] for k in self.ORDER}
         if self.people:
-            line.update({k: plain[k] for k in self.OPTIONAL})
+            line.update({k: plain[k] for k in ("people", "first_threat")})
+        if self.tracker:
+            line.update({k: plain[k] for k in ("tracker", "tracks")})
         return line
 
     def deterministic(self) -> dict[str, Any]:

@@ -11,6 +11,13 @@ from typing import Any
 
 from sim.scenario.spec import Scenario
 
+# Whom the pipeline follows: "one", the one-pedestrian tracker (the most confident person,
+# followed until lost; every result before the people tracker), or "everyone" in view
+# (monopic.people.tracker with `monopic video`'s defaults: every person's landmarks every
+# frame), whose robot warning is the worst person's (sim.runs.pipelines).
+ONE, EVERYONE = "one", "everyone"
+TRACKERS = (ONE, EVERYONE)
+
 
 @dataclass(frozen=True)
 class RunSpec:
@@ -33,4 +40,5 @@ class RunSpec:
     # The .rrd file itself, instead of record_dir/<id>.rrd (`monopic rerun --out`).
     record_file: str = ""
     intent_tree: str = ""  # a ground intent tree file: also run predictor intent-tree/ground
+    tracker: str = ONE  # whom the pipeline follows (TRACKERS)
     code: str = ""  # sim.runs.code_version of the code that runs it, written into the result

@@ -31,8 +31,9 @@ from sim.runs.result import (
     RunResult,
     ScenarioSummary,
     Timing,
+    TrackColumns,
 )
-from sim.runs.run_spec import RunSpec
+from sim.runs.run_spec import EVERYONE, RunSpec
 from sim.scenario.spec import Scenario
 from sim.world.ground_truth import GroundTruth
 from sim.world.render import RenderContext
@@ -113,12 +114,16 @@ def run(
     scenario = spec.scenario
     start = time.perf_counter()
     tree = Path(spec.intent_tree) if spec.intent_tree else None
-    onboard = [OnBoard(MAIN, make_pipeline(scenario, intent_tree=tree, tracker=tracker))]
+    main = make_pipeline(scenario, intent_tree=tree, tracker=tracker, follows=spec.tracker)
+    onboard = [OnBoard(MAIN, main)]
     if spec.ablation:
         ablation = make_pipeline(scenario, ablation=True, intent_tree=tree, tracker=tracker)
         onboard.append(OnBoard(ABLATION, ablation, truth_region))
-    truth = TruthRecorder()
+    everyone = spec.tracker == EVERYONE
+    truth = TruthRecorder(every_person=everyone)
     recorders = {board.name: PipelineRecorder(board.name) for board in onboard}
+    if everyone:
+        recorders[MAIN].tracks = TrackColumns()
     times = StepTimes()
     listeners: list[Listener] = [truth, *recorders.values(), times]
     recording_path = None
@@ -164,6 +169,8 @@ def run(
         people=truth.people,
         first_threat=truth.first_threat,
         pipelines={name: r.finished() for name, r in recorders.items()},
+        tracker=EVERYONE if everyone else "",
+        tracks={n: r.tracks for n, r in recorders.items() if r.tracks is not None},
         timing=Timing(
             wall_s=round(time.perf_counter() - start, 3),
             sim_ms=[round(v, 2) for v in times.ms],

@@ -42,7 +42,7 @@ from monopic.output import stale_temporaries_cleared
 from sim.runs.code_version import code_version
 from sim.runs.result import SCHEMA
 from sim.runs.results_file import ResultsState, ResultsWriter, check_unlocked, read_rows, scan
-from sim.runs.run_spec import RunSpec
+from sim.runs.run_spec import EVERYONE, ONE, TRACKERS, RunSpec
 from sim.scenario.files import (
     PEOPLE_KEY,
     ScenarioFile,
@@ -61,7 +61,7 @@ from sim.scenario.spec import Scenario, scenario_text
 from sim.scenario.toml_table import TomlTable, read_toml
 
 INCLUDE_SAMPLING = ("file", "base", "grid", "random")
-SPEC_KEYS = ("name", "description", "ablation", "licence", "intent_tree", "include")
+SPEC_KEYS = ("name", "description", "ablation", "licence", "intent_tree", "tracker", "include")
 
 
 @dataclass(frozen=True)
@@ -90,6 +90,9 @@ class SweepSpec:
     # A ground intent tree file (`monopic tree train --mode ground`): every run also runs
     # predictor intent-tree/ground with it, after the fixed ones (a dataset ignores it).
     intent_tree: Path | None = None
+    # Whom the pipeline follows (sim.runs.run_spec.TRACKERS): "one" pedestrian, as every
+    # sweep before the people tracker, or "everyone" in view, judged person by person.
+    tracker: str = ONE
 
 
 def load_spec(path: Path | str) -> SweepSpec:
@@ -114,6 +117,7 @@ def parse_spec(
     ablation = top.flag("ablation", True)
     licence = top.text("licence", None, nonempty=True)
     intent_tree = _intent_tree(top, path)
+    tracker = top.text("tracker", ONE, TRACKERS)
     includes = []
     for entry in top.tables("include"):
         patterns = entry.raw("files")
@@ -150,7 +154,9 @@ def parse_spec(
     top.done()
     if not includes:
         raise ScenarioFileError(path, "include", [], "a sweep needs at least one [[include]]")
-    return SweepSpec(path, name, description, ablation, tuple(includes), licence, intent_tree)
+    return SweepSpec(
+        path, name, description, ablation, tuple(includes), licence, intent_tree, tracker
+    )
 
 
 def _people(entry: TomlTable, spec: Path, value: Any, field: str) -> tuple[Path, ...]:
@@ -305,6 +311,7 @@ def expand_spec(spec: SweepSpec) -> list[RunSpec]:
                         sweep=spec.name,
                         ablation=spec.ablation,
                         intent_tree=str(spec.intent_tree) if spec.intent_tree else "",
+                        tracker=spec.tracker,
                     )
                 )
     return runs
@@ -453,15 +460,19 @@ def _check_writable(path: Path, message: str) -> None:
 def sweep_code(spec: SweepSpec) -> str:
     """The code version its results carry: with an intent tree, the tree file's digest too.
 
-    So a results file made with one tree is not resumed with another (it is "other code").
+    So a results file made with one tree is not resumed with another (it is "other code"),
+    nor one made with the one-pedestrian tracker with the people tracker (PEOPLE_TAG).
     """
     code = code_version()
+    if spec.tracker == EVERYONE:
+        code += PEOPLE_TAG
     if spec.intent_tree is None:
         return code
     return f"{code}{TREE_TAG}{tree_digest(spec.intent_tree)}"
 
 
 TREE_TAG = "+tree-"  # joins the code version and the intent tree's digest (sweep_code)
+PEOPLE_TAG = "+everyone"  # follows the code version of a sweep with the people tracker
 
 
 def tree_digest(path: Path) -> str:

@@ -19,6 +19,7 @@ from sim.runs.result import (
     RunResult,
     ScenarioSummary,
     Timing,
+    TrackColumns,
     TruthColumns,
 )
 from sim.runs.results_file import ResultsWriter, read_results
@@ -93,6 +94,13 @@ def every_field_set() -> RunResult:
             for name in ("ped", "b1")
         ],
         first_threat="b1",
+        tracker="everyone",
+        tracks={
+            "main": TrackColumns(
+                boxes=[[[1, 10.0, 20.0, 30.0, 80.0]], [], [[1, 11.0, 20.0, 31.0, 80.0]]],
+                warned_for={"rules/image": [None, None, 1]},
+            )
+        },
     )
 
 
@@ -120,7 +128,9 @@ def test_a_written_line_reads_back_with_every_field_equal(tmp_path: Path) -> Non
 def test_lines_keep_their_key_order_and_deterministic_drops_only_timing() -> None:
     record = every_field_set()
     assert list(record.to_json()) == [*RunResult.ORDER, *RunResult.OPTIONAL]
-    alone = dataclasses.replace(record, people=[], first_threat=None)  # one person
+    one = dataclasses.replace(record, tracker="", tracks={})  # the one-pedestrian tracker
+    assert list(one.to_json()) == [*RunResult.ORDER, "people", "first_threat"]
+    alone = dataclasses.replace(one, people=[], first_threat=None)  # one person
     assert list(alone.to_json()) == list(RunResult.ORDER)
     assert set(record.to_json()) - set(record.deterministic()) == {"timing"}
 
