@@ -12,16 +12,20 @@ from monopic.cli.main import main
 from sim.runs.code_version import code_version
 from sim.runs.run_spec import EVERYONE, ONE
 from sim.runs.runner import run
-from sim.runs.sweep import PEOPLE_TAG, expand_spec, load_spec, sweep_code
+from sim.runs.sweep import PEOPLE_TAG, TREE_TAG, expand_spec, load_spec, sweep_code
 
 ROOT = Path(__file__).parents[2]
 CHILD = ROOT / "scenarios" / "families" / "small" / "people" / "child_beside_adult.toml"
 
 
+GROUND_TREE = ROOT / "monopic" / "tree" / "ground_tree.json"
+
+
 def spec_file(folder: Path, tracker_line: str) -> Path:
     path = folder / "spec.toml"
     path.write_text(
-        f'name = "everyone"\n{tracker_line}\nablation = false\n[[include]]\n'
+        f'name = "everyone"\n{tracker_line}\nablation = false\n'
+        f'intent_tree = "{GROUND_TREE}"\n[[include]]\n'
         f'files = ["{CHILD}"]\nsampling = "random"\nruns = 1\nseed = 5\n'
     )
     return path
@@ -31,10 +35,11 @@ def test_the_spec_says_whom_the_pipeline_follows_and_its_results_are_other_code(
     tmp_path: Path,
 ) -> None:
     default = load_spec(spec_file(tmp_path, ""))
-    assert default.tracker == ONE and sweep_code(default) == code_version()
+    assert default.tracker == ONE
+    assert sweep_code(default).partition(TREE_TAG)[0] == code_version()
     spec = load_spec(spec_file(tmp_path, 'tracker = "everyone"'))
-    assert spec.tracker == EVERYONE
-    assert sweep_code(spec) == code_version() + PEOPLE_TAG  # never resumed as "one"'s
+    assert spec.tracker == EVERYONE  # never resumed as "one"'s results:
+    assert sweep_code(spec).partition(TREE_TAG)[0] == code_version() + PEOPLE_TAG
     assert {r.tracker for r in expand_spec(spec)} == {EVERYONE}
 
 
@@ -58,6 +63,7 @@ def test_a_run_with_the_people_tracker_says_whom_each_predictor_warned_for(
     assert max(len(frame) for frame in tracks.boxes) >= 2  # both people were followed
     decisions = row.pipelines["main"].decisions
     assert set(tracks.warned_for) == set(decisions)
+    assert "intent-tree/ground" in decisions  # the intent tree runs per person like the rest
     for key, whom in tracks.warned_for.items():
         assert len(whom) == row.frames
         for k, (pid, warn) in enumerate(zip(whom, decisions[key].warn, strict=True)):
