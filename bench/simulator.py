@@ -26,8 +26,15 @@ and the rest (steering the planned people, reading positions, the members' Track
 frame at 15 fps, beside the frame a World renders with those people (World.step with
 rendering). `--crowd-only` runs that part alone.
 
+And as a line of its own (benchmark `simulator_people_runs`), what a sweep run costs with
+1, 5 and 10 people (RUN_PEOPLE; `crowd` above): whole runs through sim.runs.runner.run on
+one core (no ablation, GL context kept, after a warm-up), with the one-pedestrian tracker
+and with the people tracker (`tracker = "everyone"`), seconds per run and per frame. The
+sweep's dry run (sim.runs.estimate) takes its per-person cost from this line.
+`--people-runs-only` runs that part alone.
+
     .venv/bin/python -m bench.simulator [--frames 60] [--runs 6] [--people-only]
-        [--crowd-only] [--no-append]
+        [--crowd-only] [--people-runs-only] [--no-append]
 """
 
 from __future__ import annotations
@@ -58,6 +65,11 @@ PEOPLE_STRETCH_X = 0.6  # the stretch goal: 10 people's frame rate over 1 person
 CROWD_TITLE = "Simulator: the crowd model's time per frame with 5 to 20 people"
 CROWD_SIZES = (5, 10, 20)  # crowd members (along the pavements; 3 of them crossing)
 CROWD_FILE = ROOT / "scenarios/families/small/crowd/crowd_crossing.toml"
+PEOPLE_RUNS_TITLE = (
+    "Simulator: a sweep run's time with 1, 5 and 10 people, one tracker and everyone"
+)
+RUN_PEOPLE = (1, 5, 10)
+TRACKER_NAMES = ("one", "everyone")  # sim.runs.run_spec.TRACKERS
 WARM_STEPS = 2  # steps of each world not timed (the new scene's first draws)
 # The bystanders in the order they join (x, y, heading in degrees, speed in m/s), in the world
 # frame: the robot starts at the origin heading east (+x) at 2 m/s, the road is along x
@@ -498,13 +510,86 @@ def child_sweep(frames: int, runs: int, workers: int) -> dict[str, Any]:
     }
 
 
+def child_people_runs(
+    frames: int, counts: Sequence[int] = RUN_PEOPLE, rounds: int = 2
+) -> dict[str, Any]:
+    """Whole runs of `crowd(n, frames)` for each count and tracker, `rounds` times in
+    alternation (so a busy spell of the machine hits every setting alike), after one
+    warm-up run per tracker; seconds per run and per frame."""
+    from monopic.pose.tracker import TrackerConfig
+    from sim.runs.run_spec import RunSpec
+    from sim.runs.runner import run
+    from sim.world.render import KeptRenderContext
+
+    tracker = TrackerConfig(threads=1)
+    out: dict[str, Any] = {"rounds": rounds}
+    with KeptRenderContext() as kept:
+        context = kept.fitting(768, 432)
+        for follows in TRACKER_NAMES:
+            warm = RunSpec(id="warm", scenario=crowd(2, 10), ablation=False,
+                           stop_at_contact=False, tracker=follows)  # fmt: skip
+            run(warm, render_context=context, tracker=tracker)
+        for _ in range(rounds):
+            for n in counts:
+                for follows in TRACKER_NAMES:
+                    spec = RunSpec(id=f"p{n}", scenario=crowd(n, frames), ablation=False,
+                                   stop_at_contact=False, tracker=follows)  # fmt: skip
+                    t0 = time.perf_counter()
+                    result = run(spec, render_context=context, tracker=tracker)
+                    wall = time.perf_counter() - t0
+                    row = out.setdefault(f"{n}/{follows}", {"wall_s": [], "frames": result.frames})
+                    row["wall_s"].append(wall)
+    out["maxrss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return out
+
+
+def people_runs_report(got: dict[str, Any], frames: int) -> tuple[dict[str, Any], str]:
+    """The people-runs child's figures as history results and a Markdown table."""
+    rows = []
+    lines = [
+        f"Scenario: bench/simulator.py `crowd(n)`: case 5 at 8 m (robot 2 m/s) with n - 1 "
+        f"bystanders, {frames} frames at 15 fps, 768x432, no ablation; sim.runs.runner.run on "
+        f"one core, GL context kept; median of {got['rounds']} runs, taken in alternation.",
+        "",
+        "| people | tracker | s per run | ms per frame | vs 1 person, same tracker "
+        "| everyone vs one |",
+        "| ---: | --- | ---: | ---: | ---: | ---: |",
+    ]
+    per_frame = {}
+    for key, row in got.items():
+        if "/" not in key:
+            continue
+        n, follows = key.split("/")
+        per_frame[(int(n), follows)] = statistics.median(row["wall_s"]) / row["frames"]
+    counts = sorted({n for n, _ in per_frame})
+    for n in counts:
+        for follows in TRACKER_NAMES:
+            if (n, follows) not in per_frame:
+                continue
+            ms = 1e3 * per_frame[(n, follows)]
+            row = got[f"{n}/{follows}"]
+            vs_one = per_frame[(n, follows)] / per_frame[(counts[0], follows)]
+            vs_tracker = per_frame[(n, follows)] / per_frame[(n, "one")]
+            rows.append({"people": n, "tracker": follows, "frames": row["frames"],
+                         "wall_s": row["wall_s"], "run_s": statistics.median(row["wall_s"]),
+                         "frame_ms": ms, "vs_one_person_x": vs_one,
+                         "vs_one_tracker_x": vs_tracker})  # fmt: skip
+            lines.append(
+                f"| {n} | {follows} | {statistics.median(row['wall_s']):.1f} | {ms:.1f} "
+                f"| {vs_one:.2f}x | {vs_tracker:.2f}x |"
+            )
+    return {"frames_per_run": frames, "rows": rows, "peak_rss_mb": got["maxrss_mb"]}, "\n".join(
+        lines
+    )
+
+
 def spawn_child(kind: str, pin: bool, **kw: Any) -> dict[str, Any]:
     from sim.runs.executors import WORKER_ENV
 
     env = dict(os.environ, **WORKER_ENV)
     cmd = [sys.executable, "-m", "bench.simulator", "--child", kind]
     for k, v in kw.items():
-        cmd += [f"--{k}", str(v)]
+        cmd += [f"--{k}", *(map(str, v) if isinstance(v, list | tuple) else [str(v)])]
     if pin:
         cmd.append("--pin")
     proc = subprocess.run(cmd, env=env, capture_output=True, text=True, cwd=ROOT, check=False)
@@ -527,7 +612,13 @@ def main() -> None:
         help="only the crowd model's time per frame with 5 to 20 people (its own history line)",
     )  # fmt: skip
     ap.add_argument(
-        "--child", choices=("render", "run", "sweep", "people", "crowd"), help=argparse.SUPPRESS
+        "--people-runs-only", action="store_true",
+        help="only a sweep run's time with 1, 5 and 10 people (its own history line)",
+    )  # fmt: skip
+    ap.add_argument(
+        "--child",
+        choices=("render", "run", "sweep", "people", "crowd", "people_runs"),
+        help=argparse.SUPPRESS,
     )
     ap.add_argument("--people", type=int, nargs="+", default=PEOPLE, help=argparse.SUPPRESS)
     ap.add_argument("--rounds", type=int, default=2, help=argparse.SUPPRESS)
@@ -547,6 +638,8 @@ def main() -> None:
             out = child_people(args.frames, args.people, args.rounds)
         elif args.child == "crowd":
             out = child_crowd(args.frames)
+        elif args.child == "people_runs":
+            out = child_people_runs(args.frames, args.people, args.rounds)
         elif args.child == "run":
             out = child_run(
                 args.frames, bool(args.ablation), bool(args.shadows), args.model, args.runtime
@@ -556,6 +649,16 @@ def main() -> None:
         print(json.dumps(out))
         return
 
+    if args.people_runs_only or not (args.people_only or args.crowd_only):
+        recorder = Recorder("simulator_people_runs", PEOPLE_RUNS_TITLE)
+        counts = [n for n in args.people if n in RUN_PEOPLE] or list(RUN_PEOPLE)
+        got = spawn_child("people_runs", True, frames=args.frames, rounds=args.rounds,
+                          people=counts)  # fmt: skip
+        results, table = people_runs_report(got, args.frames)
+        print(table)
+        recorder.finish(results, table, write=not args.no_append)
+        if args.people_runs_only:
+            return
     if not (args.people_only or args.crowd_only):
         main_rows(args)
     if not args.people_only:
