@@ -124,6 +124,27 @@ def kept_recordings(folder: Path, record: str) -> str:
     return f"recordings ({which}): {len(kept)} in {folder}"
 
 
+def _bench_of_line(row: dict) -> float:
+    """The benchmark's seconds per frame for a finished run's line: its camera, ablation,
+    people and tracker (what the estimate scales by the line's measured time)."""
+    from dataclasses import replace
+
+    from sim.runs.estimate import bench_frame_seconds
+    from sim.runs.result import ABLATION
+    from sim.runs.run_spec import EVERYONE, ONE
+    from sim.scenario.spec import CameraSpec
+
+    summary = row.get("scenario") if isinstance(row.get("scenario"), dict) else {}
+    camera = summary.get("camera") if isinstance(summary.get("camera"), dict) else {}
+    size = CameraSpec()
+    size = replace(size, width=int(camera.get("width", size.width)),
+                   height=int(camera.get("height", size.height)))  # fmt: skip
+    pipelines = row.get("pipelines") if isinstance(row.get("pipelines"), dict) else {}
+    people = row.get("people") if isinstance(row.get("people"), list) else []
+    tracker = EVERYONE if row.get("tracker") == EVERYONE else ONE
+    return bench_frame_seconds(size, ABLATION in pipelines, max(len(people), 1), tracker)
+
+
 def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
     """Runs per family, what the results file already holds and the estimated time.
 
@@ -169,15 +190,18 @@ def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
             timing = row.get("timing") if isinstance(row.get("timing"), dict) else {}
             wall, frames = timing.get("wall_s"), row.get("frames")
             if isinstance(wall, int | float) and isinstance(frames, int):
-                measured.append((frames, float(wall)))
+                measured.append((frames, float(wall), _bench_of_line(row)))
 
     def ablation(r: RunSpec) -> bool:
         return r.ablation if args.ablation is None else args.ablation
 
+    def bench(r: RunSpec) -> float:
+        people = len(r.scenario.people)
+        return bench_frame_seconds(r.scenario.robot.camera, ablation(r), people, r.tracker)
+
     workers = workers_of(args)
     time = estimate_time(
-        [(r.scenario.frames, bench_frame_seconds(r.scenario.robot.camera, ablation(r)))
-         for r in todo],
+        [(r.scenario.frames, bench(r)) for r in todo],
         measured,
         workers,
         f"in {out}",

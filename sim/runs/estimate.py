@@ -17,6 +17,13 @@ spent 8 s before its first run began (spawning workers that import MuJoCo, onnxr
 and the pipeline, on 2 cores). A dataset starts the same workers and merges at the
 end: 5 s beyond its runs' own time on one worker, 6-10 s on two (a 3-run 384x216
 dataset).
+
+People cost too: each person beyond the first adds to the world's render and truth, and
+with the people tracker (a sweep's `tracker = "everyone"`) to the pipeline, which runs
+their landmarks every frame. The per-person figures come from the benchmark's
+`simulator_people_runs` line (whole runs with 1, 5 and 10 people under each tracker);
+finished runs then scale every run's benchmark cost by how much slower or faster this
+machine ran theirs, so a sweep mixing one person and ten is estimated run by run.
 """
 
 from __future__ import annotations
@@ -24,21 +31,37 @@ from __future__ import annotations
 from collections.abc import Iterable
 from dataclasses import dataclass
 
+from sim.runs.run_spec import EVERYONE, ONE
 from sim.scenario.spec import CameraSpec
 
 BENCH_PIXELS = 768 * 432
 BENCH_RENDER_S = 0.0456  # MuJoCo render of one 768x432 frame (llvmpipe), one core
 BENCH_PIPELINE_S = 0.0795 - BENCH_RENDER_S  # pose, features, five predictors, truth
 BENCH_ABLATION_S = 0.1012 - 0.0795  # the ground-truth-crop pipeline on the same frame
-BENCH_SOURCE = "the simulator benchmark's 79.5/101.2 ms per 768x432 frame (bench/history.jsonl)"
+BENCH_SOURCE = (
+    "the simulator benchmark's 79.5/101.2 ms per 768x432 frame and its per-person figures "
+    "(bench/history.jsonl)"
+)
+# Per person beyond the first, and the people tracker's own cost with one person, as
+# shares of a one-person frame (bench/simulator.py --people-runs-only, 2026-12-07 on the
+# 2-core AMD EPYC while a sweep ran beside it: 264, 567 and 769 ms a frame with 1, 5 and
+# 10 people under the one tracker, 362 and 1080 ms with 1 and 10 under everyone), times
+# the quiet whole-run figure above (79.5 ms): 0.212, 0.302 and 0.371 of it.
+ONE_PERSON_FRAME_S = 0.0795
+BENCH_PERSON_S = {ONE: 0.212 * ONE_PERSON_FRAME_S, EVERYONE: 0.302 * ONE_PERSON_FRAME_S}
+BENCH_EVERYONE_S = 0.371 * ONE_PERSON_FRAME_S
 SWEEP_START_S = 8.0  # from the command's start to its workers' first runs (measured)
 DATASET_START_S = 8.0  # a dataset's workers starting, and its merge (measured)
 
 
-def bench_frame_seconds(camera: CameraSpec, ablation: bool) -> float:
+def bench_frame_seconds(
+    camera: CameraSpec, ablation: bool, people: int = 1, tracker: str = ONE
+) -> float:
     """One worker's seconds per frame of a run, from the benchmark (module docstring)."""
     render = BENCH_RENDER_S * camera.width * camera.height / BENCH_PIXELS
-    return render + BENCH_PIPELINE_S + (BENCH_ABLATION_S if ablation else 0.0)
+    base = render + BENCH_PIPELINE_S + (BENCH_ABLATION_S if ablation else 0.0)
+    others = max(people - 1, 0) * BENCH_PERSON_S[tracker]
+    return base + others + (BENCH_EVERYONE_S if tracker == EVERYONE else 0.0)
 
 
 @dataclass(frozen=True)
@@ -87,21 +110,32 @@ def _duration(seconds: float) -> str:
 
 def estimate_time(
     to_run: Iterable[tuple[int, float]],
-    measured: Iterable[tuple[int, float]],
+    measured: Iterable[tuple[int, float] | tuple[int, float, float]],
     workers: int | None,
     measured_where: str,
     start_seconds: float = 0.0,
 ) -> TimeEstimate:
     """The time of runs given as (frames, benchmark seconds per frame).
 
-    `measured`: (frames, wall seconds) of finished runs; when there are any, their mean
-    per-frame time replaces the benchmark's. `measured_where` names them for the text."""
+    `measured`: (frames, wall seconds) of finished runs, or (frames, wall seconds,
+    benchmark seconds per frame). With the benchmark's figure each run still to do costs
+    its own benchmark figure times the finished runs' measured over benchmark time (this
+    machine's speed, learnt); without it their mean per-frame time replaces the
+    benchmark's. `measured_where` names them for the text."""
     todo = list(to_run)
     frames = sum(f for f, _ in todo)
-    done = [(f, s) for f, s in measured if f > 0 and s > 0]
-    if done:
-        per = sum(s for _, s in done) / sum(f for f, _ in done)
-        source = f"measured on {len(done)} finished run{'s' * (len(done) > 1)} {measured_where}"
+    done = [m for m in measured if m[0] > 0 and m[1] > 0]
+    runs_said = f"{len(done)} finished run{'s' * (len(done) > 1)} {measured_where}"
+    if done and all(len(m) == 3 for m in done):
+        scale = sum(m[1] for m in done) / sum(m[0] * m[2] for m in done)  # type: ignore[misc]
+        per = scale * sum(f * s for f, s in todo) / frames if frames else 0.0
+        source = (
+            f"each run's benchmark figure for its camera and people x {scale:.2f}, "
+            f"as measured on {runs_said}"
+        )
+    elif done:
+        per = sum(m[1] for m in done) / sum(m[0] for m in done)
+        source = f"measured on {runs_said}"
     else:
         per = sum(f * s for f, s in todo) / frames if frames else 0.0
         source = BENCH_SOURCE + "; no run measured yet"
