@@ -208,14 +208,13 @@ def summarise_rows(rows: Sequence[RunResult], method: str) -> PersonByPersonSumm
 
 
 def _first_threat(row: RunResult, on_course: Sequence[Sequence[bool]]) -> int | None:
-    """The line's `first_threat` as an index; from the columns when the name is not
-    among the people (the recorder's rule: the first frame anyone is on course, the
-    first of them in the scenario's order)."""
+    """The line's `first_threat` as an index when that person is ever on course, else by
+    the recorder's rule from the columns (the first frame anyone is on course, the first
+    of them in the scenario's order); None when nobody is."""
     names = [p.name for p in row.people]
-    if row.first_threat in names:
+    if row.first_threat in names and any(on_course[names.index(row.first_threat)]):
         return names.index(row.first_threat)
-    frames = len(row.truth.t)
-    for k in range(frames):
+    for k in range(len(row.truth.t)):
         for i, course in enumerate(on_course):
             if course[k]:
                 return i
