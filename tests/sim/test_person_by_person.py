@@ -170,3 +170,27 @@ def test_the_report_judges_people_tracker_lines_person_by_person(tmp_path: Path)
     assert "**warned for adult who was not on a collision course (12 frames)**" in triage
     assert "`fam/ghost` (the file's values): **warned for nobody (a phantom) (2 frames)**" in triage
     assert "`fam/ok`" not in triage
+
+
+@pytest.mark.slow
+def test_a_real_people_tracker_run_is_judged_and_scored(tmp_path: Path) -> None:
+    from sim.runs.runner import run
+    from sim.runs.sweep import expand_spec, load_spec
+    from tests.sim.test_people_tracker_runs import spec_file
+
+    (spec,) = expand_spec(load_spec(spec_file(tmp_path, 'tracker = "everyone"')))
+    row = RunResult.from_json(run(spec).to_json())  # as the report reads it back
+    child = [p.name for p in row.people].index("child")
+    verdicts = judge_runs(row, row.pipelines["main"].decisions)
+    assert set(verdicts) == set(row.tracks["main"].warned_for)
+    for key, v in verdicts.items():
+        warned = sum(w is not None for w in row.tracks["main"].warned_for[key])
+        assert v.warned_frames == warned
+        assert v.for_threat_frames + v.wrong_person_frames + v.phantom_frames == warned
+        assert v.threatened and v.first_threat == child  # the child steps out
+    # Somebody's warning is for the child on course: the pairing finds them.
+    assert any(v.for_threat_frames for v in verdicts.values())
+    s = tracking_by_family([row])[row.family]  # type: ignore[index]
+    in_view = sum(sum(p.in_frame) for p in row.people)
+    assert s.gt_boxes == in_view and s.gt_identities == len(row.people)
+    assert 0.0 < s.idf1 <= 1.0 and s.mota <= 1.0 and s.matches > 0
