@@ -22,6 +22,7 @@ opencv-python, which clashes with the pinned opencv-python-headless.
 
 from __future__ import annotations
 
+import importlib.util
 import math
 import re
 from collections.abc import Iterable, Mapping, Sequence
@@ -273,6 +274,12 @@ class TrackScores:
         }
 
 
+def has_motmetrics() -> bool:
+    """Whether motmetrics (the [tracking] extra) is installed, without importing it: a
+    report says how to install it rather than failing."""
+    return importlib.util.find_spec("motmetrics") is not None
+
+
 def _motmetrics() -> Any:
     """motmetrics, imported when scoring: it is the [tracking] extra, and it brings pandas
     and scipy, which every other `monopic` command would otherwise pay for at start."""
@@ -322,16 +329,24 @@ def _by_frame(rows: Iterable[MotRow], frames: FrameRange) -> dict[int, list[MotR
     return out
 
 
-def score_tracks(
-    tracks: Sequence[MotRow],
-    truth: Sequence[MotRow],
-    frames: FrameRange,
-    min_iou: float = 0.5,
-) -> TrackScores:
-    """Score `tracks` against the ground truth `truth` over `frames` (CLEAR MOT, IDF1).
+@dataclass
+class _Accumulated:
+    """One sequence fed to motmetrics frame by frame, with what the accumulator does not
+    keep: the scored track boxes, those taken out as distractors', and the rows by frame."""
 
-    A track box and a ground-truth box can match when their IoU is at least `min_iou`."""
-    mm = _motmetrics()
+    acc: Any
+    track_boxes: int
+    distractor_boxes: int
+    truth_frames: dict[int, list[MotRow]]
+    track_frames: dict[int, list[MotRow]]
+
+
+def _accumulate(
+    mm: Any, tracks: Sequence[MotRow], truth: Sequence[MotRow], frames: FrameRange, min_iou: float
+) -> _Accumulated:
+    """One sequence's frames into a motmetrics accumulator, MOTChallenge's conventions
+    applied (module docstring): unscored rows neither found nor missed, distractors' boxes
+    taken out."""
     track_frames = _by_frame(tracks, frames)
     truth_frames = _by_frame(truth, frames)
     acc = mm.MOTAccumulator(auto_id=False)
@@ -349,13 +364,29 @@ def score_tracks(
             _distances(mm, scored, kept, min_iou),
             frameid=frame,
         )
-    names = [
-        "mota", "motp", "idf1", "idp", "idr", "recall", "precision", "num_switches",
-        "num_fragmentations", "num_false_positives", "num_misses", "num_detections",
-        "num_objects", "num_unique_objects", "mostly_tracked", "partially_tracked",
-        "mostly_lost",
-    ]  # fmt: skip
-    m = mm.metrics.create().compute(acc, metrics=names, return_dataframe=False)
+    return _Accumulated(acc, track_boxes, distractor_boxes, truth_frames, track_frames)
+
+
+_METRICS = [
+    "mota", "motp", "idf1", "idp", "idr", "recall", "precision", "num_switches",
+    "num_fragmentations", "num_false_positives", "num_misses", "num_detections",
+    "num_objects", "num_unique_objects", "mostly_tracked", "partially_tracked",
+    "mostly_lost",
+]  # fmt: skip
+
+
+def score_tracks(
+    tracks: Sequence[MotRow],
+    truth: Sequence[MotRow],
+    frames: FrameRange,
+    min_iou: float = 0.5,
+) -> TrackScores:
+    """Score `tracks` against the ground truth `truth` over `frames` (CLEAR MOT, IDF1).
+
+    A track box and a ground-truth box can match when their IoU is at least `min_iou`."""
+    mm = _motmetrics()
+    seq = _accumulate(mm, tracks, truth, frames, min_iou)
+    m = mm.metrics.create().compute(seq.acc, metrics=_METRICS, return_dataframe=False)
     return TrackScores(
         frames=frames,
         min_iou=min_iou,
@@ -373,16 +404,83 @@ def score_tracks(
         misses=int(m["num_misses"]),
         matches=int(m["num_detections"]),
         gt_boxes=int(m["num_objects"]),
-        track_boxes=track_boxes,
-        distractor_boxes=distractor_boxes,
+        track_boxes=seq.track_boxes,
+        distractor_boxes=seq.distractor_boxes,
         false_positives_on_unscored=_false_positives_on_unscored(
-            mm, acc.mot_events, truth_frames, track_frames, min_iou
+            mm, seq.acc.mot_events, seq.truth_frames, seq.track_frames, min_iou
         ),
         gt_identities=int(m["num_unique_objects"]),
         mostly_tracked=int(m["mostly_tracked"]),
         partially_tracked=int(m["partially_tracked"]),
         mostly_lost=int(m["mostly_lost"]),
-        identities=_identity_scores(acc.mot_events, truth_frames),
+        identities=_identity_scores(seq.acc.mot_events, seq.truth_frames),
+    )
+
+
+@dataclass(frozen=True)
+class MotSequence:
+    """One sequence to score among several: its tracks, its ground truth, its frames."""
+
+    tracks: Sequence[MotRow]
+    truth: Sequence[MotRow]
+    frames: FrameRange
+
+
+@dataclass(frozen=True)
+class PooledScores:
+    """The figures of several sequences scored together, as MOTChallenge's benchmark sums
+    a tracker over its sequences (motmetrics' overall): counts summed, MOTA and IDF1 of
+    the sums, so a long sequence weighs more than a short one. Identities are per
+    sequence: one person in two sequences counts twice."""
+
+    sequences: int
+    min_iou: float
+    mota: float
+    motp: float  # mean IoU of the matched boxes
+    idf1: float
+    recall: float
+    precision: float
+    switches: int
+    fragmentations: int
+    false_positives: int
+    misses: int
+    matches: int
+    gt_boxes: int
+    gt_identities: int
+
+    @property
+    def switches_per_100(self) -> float:
+        """Identity switches per 100 ground-truth boxes (person-frames)."""
+        return 100.0 * self.switches / self.gt_boxes if self.gt_boxes else math.nan
+
+
+def score_sequences(sequences: Sequence[MotSequence], min_iou: float = 0.5) -> PooledScores:
+    """Score several sequences together (each its own accumulator, then motmetrics'
+    overall); ValueError when there is none."""
+    if not sequences:
+        raise ValueError("no sequence to score")
+    mm = _motmetrics()
+    accs = [_accumulate(mm, s.tracks, s.truth, s.frames, min_iou).acc for s in sequences]
+    names = [str(i) for i in range(len(accs))]
+    table = mm.metrics.create().compute_many(
+        accs, names=names, metrics=_METRICS, generate_overall=True
+    )
+    m = table.loc["OVERALL"]
+    return PooledScores(
+        sequences=len(sequences),
+        min_iou=min_iou,
+        mota=float(m["mota"]),
+        motp=1.0 - float(m["motp"]),
+        idf1=float(m["idf1"]),
+        recall=float(m["recall"]),
+        precision=float(m["precision"]),
+        switches=int(m["num_switches"]),
+        fragmentations=int(m["num_fragmentations"]),
+        false_positives=int(m["num_false_positives"]),
+        misses=int(m["num_misses"]),
+        matches=int(m["num_detections"]),
+        gt_boxes=int(m["num_objects"]),
+        gt_identities=int(m["num_unique_objects"]),
     )
 
 

@@ -11,7 +11,9 @@ else the person whose box's bottom centre is nearest to it. A warning is then
 - unattributed: the pipeline had no foot point that frame (it warned from memory).
 
 Runs with one person have no per-person columns; their warnings are the scripted
-person's by construction and are not counted here.
+person's by construction and are not counted here. Lines of the people tracker (`tracker`
+"everyone") name the track each warning was for: the report judges them by that track
+(sim.analysis.person_by_person), not by the foot point.
 """
 
 from __future__ import annotations

@@ -31,6 +31,8 @@ from sim.analysis.metrics import (
     split_method,
 )
 from sim.analysis.people import summarise_people
+from sim.analysis.person_by_person import is_everyone
+from sim.analysis.person_report import person_by_person_lines
 from sim.analysis.triage import Rerunning, triage_lines
 from sim.runs.result import RunResult
 
@@ -341,6 +343,7 @@ def write_report(
         *table(["lighting", *GROUP_COLUMNS], group_rows(m.by_lighting, main_methods, str)),
         "",
         *people_lines(rows, main_methods),
+        *person_by_person_lines(rows, main_methods),
         "## Ablation: real pose vs ground-truth crop",
         "",
         "The gap between the columns is what the pose stage costs; what remains with the true",
@@ -468,8 +471,9 @@ def write_report(
 
 def people_lines(rows: Sequence[RunResult], methods: Sequence[str]) -> list[str]:
     """Runs with several people: each warning set against the person it was for
-    (sim/analysis/people.py), per family; nothing when every run has one person."""
-    crowded = [r for r in rows if r.people]
+    (sim/analysis/people.py), per family; nothing when every run has one person. Lines of
+    the people tracker are judged person by person instead (person_by_person_lines)."""
+    crowded = [r for r in rows if r.people and not is_everyone(r)]
     if not crowded:
         return []
     body = []

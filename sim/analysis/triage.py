@@ -6,6 +6,11 @@ what the report's tables count: missed is a collision run without a warning onse
 contact (not in recall); late is an onset less than LEAD_GOAL before contact (in recall,
 not in recall@1s); a near miss warned is a near-miss run with any warned frame (the
 table's "near-miss warned").
+
+Lines of the people tracker add two (sim.analysis.person_by_person): a run where the
+primary predictor warned for someone not on a collision course that frame (the wrong
+person), or for a track paired with no one (a phantom); a run already listed for the
+three says so after "also".
 """
 
 from __future__ import annotations
@@ -20,11 +25,14 @@ from typing import Any
 
 from sim.analysis.markdown import table
 from sim.analysis.metrics import LEAD_GOAL, MAIN, RunOutcome, SweepMetrics, split_method
+from sim.analysis.person_by_person import is_everyone, judge_run
 from sim.runs.result import RunResult, values_said
 
 MISSED, LATE, NEAR_MISS = "missed", "late", "near miss warned"
 WHATS = (MISSED, LATE, NEAR_MISS)  # also the order of the list: the worst first
 PER_FAMILY = 5  # runs listed per family; the others are counted
+WRONG_PERSON, PHANTOM = "wrong person warned", "phantom warned"
+SWEEP_WHATS = (*WHATS, WRONG_PERSON, PHANTOM)  # the sweep report's list, the worst first
 
 
 def went_wrong(o: RunOutcome) -> str | None:
@@ -65,6 +73,36 @@ def primary(m: SweepMetrics) -> str | None:
     """The primary predictor of the real pipeline: the first main method (rules/image in
     the metrics' order, the pipeline's own primary, whose warning is the robot's)."""
     return next((x for x in m.methods if split_method(x)[0] == MAIN), None)
+
+
+@dataclass(frozen=True)
+class PersonTrouble:
+    """A people-tracker run's warnings for the wrong person or for nobody (one method)."""
+
+    what: str  # WRONG_PERSON or PHANTOM
+    how: str  # in words, naming whom
+    frames: int
+
+
+def person_trouble(row: RunResult, method: str) -> list[PersonTrouble]:
+    """The wrong-person then phantom warnings of `method` on a people-tracker line; []
+    for other lines and for runs without them."""
+    v = judge_run(row, method) if is_everyone(row) else None
+    if v is None:
+        return []
+    out = []
+    if v.wrong_people:
+        names = " and ".join(row.people[i].name for i in v.wrong_people)
+        verb = "was" if len(v.wrong_people) == 1 else "were"
+        how = f"warned for {names} who {verb} not on a collision course"
+        out.append(PersonTrouble(WRONG_PERSON, how, v.wrong_person_frames))
+    if v.phantom_frames:
+        out.append(PersonTrouble(PHANTOM, "warned for nobody (a phantom)", v.phantom_frames))
+    return out
+
+
+def said_trouble(t: PersonTrouble) -> str:
+    return f"{t.how} ({plural(t.frames, 'frame')})"
 
 
 @dataclass(frozen=True)
@@ -169,6 +207,7 @@ def triage_lines(m: SweepMetrics, rows: Sequence[RunResult], where: Rerunning) -
     mains = [x for x in m.methods if split_method(x)[0] == MAIN]
     others = {x: {o.id: o for o in m.outcomes[x]} for x in mains if x != first}
     wrong = sorted((o for o in m.outcomes[first] if went_wrong(o)), key=severity)
+    trouble = {r.id: person_trouble(r, first) for r in rows}
     lines = [
         "## Runs to look at",
         "",
@@ -184,13 +223,25 @@ def triage_lines(m: SweepMetrics, rows: Sequence[RunResult], where: Rerunning) -
         "opens a recording, one lane per predictor.",
         "",
     ]
-    if not wrong:
-        lines += [f"None: {first} missed no collision, warned none late and no near miss.", ""]
+    if any(is_everyone(r) for r in rows):
+        lines += [
+            "With the people tracker, also the runs where it warned for someone not on a",
+            "collision course that frame (wrong person warned) or for a track paired with no",
+            "one (phantom warned), as the section person by person judges them.",
+            "",
+        ]
+    if not wrong and not any(trouble.values()):
+        people = ", none for the wrong person or nobody" if any(map(is_everyone, rows)) else ""
+        lines += [
+            f"None: {first} missed no collision, warned none late and no near miss{people}.",
+            "",
+        ]
     listed = []
     for o in wrong:
         row = by_id.get(o.id)  # the metrics' rows (a caller may pass none)
         also = [f"{x} {went_wrong(others[x][o.id])}" for x in others
                 if went_wrong(others[x][o.id])]  # fmt: skip
+        also += [said_trouble(t) for t in trouble.get(o.id, [])]
         link = where.link(row) if row else None
         listed.append(
             Listed(
@@ -204,8 +255,9 @@ def triage_lines(m: SweepMetrics, rows: Sequence[RunResult], where: Rerunning) -
                 recording=f"recording {link or 'not kept'}",
             )
         )
+    listed += _troubled(rows, trouble, {o.id for o in wrong}, others, where)
     runs = Counter(o.family for o in m.outcomes[first])
-    lines += listed_lines(listed, WHATS, runs)
+    lines += listed_lines(listed, SWEEP_WHATS, runs)
     if any(where.needs_tree(r.code) for r in rows):
         lines += [
             "TREE: the intent tree file the sweep spec names (`intent_tree`); these runs ran "
@@ -223,6 +275,37 @@ def triage_lines(m: SweepMetrics, rows: Sequence[RunResult], where: Rerunning) -
         "",
     ]
     return lines
+
+
+def _troubled(
+    rows: Sequence[RunResult],
+    trouble: Mapping[str, Sequence[PersonTrouble]],
+    listed: set[str],
+    others: Mapping[str, Mapping[str, RunOutcome]],
+    where: Rerunning,
+) -> list[Listed]:
+    """Runs not listed for the three whose primary predictor warned for the wrong person
+    or for nobody: wrong persons first, then by frames so warned, then by id."""
+    found = [(r, trouble[r.id]) for r in rows if trouble.get(r.id) and r.id not in listed]
+    found.sort(key=lambda f: (SWEEP_WHATS.index(f[1][0].what), -f[1][0].frames, f[0].id))
+    out = []
+    for row, troubles in found:
+        also = [f"{x} {went_wrong(by[row.id])}" for x, by in others.items()
+                if row.id in by and went_wrong(by[row.id])]  # fmt: skip
+        link = where.link(row)
+        out.append(
+            Listed(
+                id=row.id,
+                group=row.family,
+                what=troubles[0].what,
+                how=said_trouble(troubles[0]),
+                values=values_said(row.params),
+                command=where.command(row.id, row.code),
+                also=(*(said_trouble(t) for t in troubles[1:]), *also),
+                recording=f"recording {link or 'not kept'}",
+            )
+        )
+    return out
 
 
 def _counts_table(m: SweepMetrics, methods: Sequence[str]) -> list[str]:

@@ -21,29 +21,16 @@ track-eval TRACKS --gt mot/<run>` reads it as it reads a real one (PETS09-S2L1),
 
 from __future__ import annotations
 
-import math
 import os
 from pathlib import Path
 
+from sim.geometry.box_match import clipped_box
 from sim.world.ground_truth import PersonTruth
 
 MOT = "mot"  # the dataset's folder of sequences
 SEQINFO = "seqinfo.ini"
 IMAGE_DIR = "img1"
 PEDESTRIAN_CLASS = 1  # MOT16/17's class of a pedestrian
-
-
-def clipped_box(
-    box: tuple[float, float, float, float], width: int, height: int
-) -> list[float] | None:
-    """[left, top, width, height] of an (u0, v0, u1, v1) box clipped to the image, to 0.01
-    px; None when the box is not finite."""
-    u0, v0, u1, v1 = box
-    if not all(math.isfinite(v) for v in (u0, v0, u1, v1)):
-        return None
-    x0, y0 = min(max(u0, 0.0), width), min(max(v0, 0.0), height)
-    x1, y1 = min(max(u1, 0.0), width), min(max(v1, 0.0), height)
-    return [round(x0, 2), round(y0, 2), round(x1 - x0, 2), round(y1 - y0, 2)]
 
 
 def gt_line(frame: int, track_id: int, person: PersonTruth, width: int, height: int) -> str | None:

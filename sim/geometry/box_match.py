@@ -13,6 +13,7 @@ track paired with nobody is a phantom: a warning for it is for no one.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -35,6 +36,21 @@ def clipped(box: Box | None, width: int, height: int) -> tuple[float, float, flo
     u0, u1 = max(u0, 0.0), min(u1, float(width))
     v0, v1 = max(v0, 0.0), min(v1, float(height))
     return (u0, v0, u1, v1) if u1 > u0 and v1 > v0 else None
+
+
+def clipped_box(
+    box: tuple[float, float, float, float], width: int, height: int
+) -> list[float] | None:
+    """[left, top, width, height] of an (u0, v0, u1, v1) box clipped to the image, to 0.01
+    px, as the dataset's MOTChallenge gt.txt writes it (sim.dataset.mot) and the sweep
+    report scores tracking against it; None when the box is not finite (a box wholly
+    outside the image comes out empty: whether the person is in view is the caller's)."""
+    u0, v0, u1, v1 = box
+    if not all(math.isfinite(v) for v in (u0, v0, u1, v1)):
+        return None
+    x0, y0 = min(max(u0, 0.0), width), min(max(v0, 0.0), height)
+    x1, y1 = min(max(u1, 0.0), width), min(max(v1, 0.0), height)
+    return [round(x0, 2), round(y0, 2), round(x1 - x0, 2), round(y1 - y0, 2)]
 
 
 def match_tracks(
