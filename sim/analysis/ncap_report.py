@@ -199,7 +199,8 @@ def braked_for_lines(rows: Sequence[dict[str, Any]]) -> list[str]:
         "",
         "At the frame whose warning made the brake act, the warned track matched to the "
         "truth's people by box overlap: braking for the wrong person is braking for someone "
-        "not on a collision course then, or for nobody (a track that is no one).",
+        "not on a collision course then (the footprints would not meet at constant speeds), "
+        "or for nobody (a track that is no one).",
         "",
         "| policy | braked | for the person on course | wrong person | of them: someone "
         "else | of them: nobody |",

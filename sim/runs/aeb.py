@@ -196,6 +196,7 @@ class AebOutcome:
     braked_for_track: int | None = None
     braked_for_on_course: bool | None = None
     people: int = 1
+    braked_for_ttc: float | None = None
 
     @property
     def braked(self) -> bool:

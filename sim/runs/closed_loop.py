@@ -90,6 +90,7 @@ class LoopOutcome:
     braked_for_track: int | None = None  # the pipeline's person id (None: the oracle)
     braked_for_on_course: bool | None = None  # on a collision course at that frame
     people: int = 1  # people in the scenario
+    braked_for_ttc: float | None = None  # s, that person's true time to collision then
 
     @property
     def braked(self) -> bool:
@@ -107,13 +108,15 @@ class LoopOutcome:
         """'braked for adult (track 3, not on a collision course)', None if unnamed."""
         if self.braked_for is None:
             return None
-        who = WarnedFor(self.braked_for_track, self.braked_for, bool(self.braked_for_on_course))
-        return f"braked for {who.said()}"
+        ttc = self.braked_for_ttc if self.braked_for_on_course else None
+        if self.braked_for_on_course and ttc is None:  # a line without the time
+            ttc = math.nan
+        return f"braked for {WarnedFor(self.braked_for_track, self.braked_for, ttc).said()}"
 
 
 # The outcome's fields a run writes only with the people tracker or several people, so a
 # one-tracker run of one person writes the line it always wrote (sim.runs.result's rule).
-OPTIONAL = ("braked_for", "braked_for_track", "braked_for_on_course", "people")
+OPTIONAL = ("braked_for", "braked_for_track", "braked_for_on_course", "people", "braked_for_ttc")
 
 
 def outcome_json(outcome: LoopOutcome | Any, tracker: str) -> dict[str, Any]:
@@ -375,6 +378,7 @@ def braked_for_fields(acted: WarnedFor | None) -> dict[str, Any]:
         "braked_for": acted.name,
         "braked_for_track": acted.track,
         "braked_for_on_course": acted.on_course,
+        "braked_for_ttc": acted.ttc,
     }
 
 

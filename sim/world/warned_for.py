@@ -6,12 +6,21 @@ person). The truth knows who stood where: that track's box is paired with the pe
 whole-body boxes (sim.geometry.box_match, one-to-one over all of the frame's tracks, so
 two tracks never claim one person), giving the person's name and whether they were on a
 collision course then. A track paired with nobody is a phantom: a brake on its warning is
-a brake for nobody. The closed loop names with it the person each run braked for, the
+a brake for nobody.
+
+On a collision course means the truth's footprints meet if the robot keeps its course
+(PersonTruth.time_to_collision, searched over the world's lookahead), not only within the
+horizon (PersonTruth.collision): a warning may rightly lead the horizon (the Euro NCAP
+FCW is timely at 1.7 s and more; the pipeline's own prediction reaches past where the
+truth's horizon ends), and braking for the person the car would hit is braking for the
+right person however early. The time to collision is kept, so a reader can hold a
+warning to the horizon too. The closed loop names with it the person each run braked for, the
 recordings the person each warning was for.
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
 from monopic.pipeline import FrameResult
@@ -27,7 +36,12 @@ class WarnedFor:
 
     track: int | None  # the pipeline's person id (None: no track, the oracle's warning)
     name: str  # the truth's person (PersonTruth.name) or NOBODY
-    on_course: bool  # that person was on a collision course (within the horizon)
+    ttc: float | None  # s until the footprints meet at constant speeds; None: they do not
+
+    @property
+    def on_course(self) -> bool:
+        """That person was on a collision course (the footprints meet ahead)."""
+        return self.ttc is not None
 
     @property
     def wrong(self) -> bool:
@@ -39,7 +53,12 @@ class WarnedFor:
         track = f"track {self.track}, " if self.track is not None else ""
         if self.name == NOBODY:
             return f"{NOBODY} ({track}a phantom)"
-        course = "on a collision course" if self.on_course else "not on a collision course"
+        if self.ttc is None:
+            course = "not on a collision course"
+        elif math.isfinite(self.ttc):
+            course = f"on a collision course, contact in {self.ttc:.2f} s"
+        else:  # on course, the time not known
+            course = "on a collision course"
         return f"{self.name} ({track}{course})"
 
 
@@ -55,11 +74,15 @@ def warned_for(result: FrameResult, truth: GroundTruth) -> WarnedFor | None:
     pairs = match_tracks(tracks, [p.box for p in truth.people], width, height)
     k = pairs.get(result.person_id)
     if k is None:
-        return WarnedFor(result.person_id, NOBODY, False)
+        return WarnedFor(result.person_id, NOBODY, None)
     person = truth.people[k]
-    return WarnedFor(result.person_id, person.name, bool(person.collision))
+    return WarnedFor(result.person_id, person.name, _ttc(person.time_to_collision))
 
 
 def oracle_warned_for(truth: GroundTruth) -> WarnedFor:
-    """The oracle policy's warning: the scripted person's truth, on course by definition."""
-    return WarnedFor(None, truth.pedestrian.name, bool(truth.pedestrian.collision))
+    """The oracle policy's warning: the scripted person's truth (it warns on their course)."""
+    return WarnedFor(None, truth.pedestrian.name, _ttc(truth.pedestrian.time_to_collision))
+
+
+def _ttc(value: float | None) -> float | None:
+    return None if value is None else round(float(value), 4)

@@ -36,22 +36,26 @@ def _result(person_id: int | None, boxes: dict[int, tuple[float, float, float, f
     return FrameResult(0, 0.0, None, None, (), {}, (640, 360), "rules/image", people, person_id)  # type: ignore[arg-type]
 
 
-def _truth(*people: tuple[str, tuple[float, float, float, float] | None, bool]):
-    """Just what warned_for reads of a GroundTruth: each person's name, box and course."""
+def _truth(*people: tuple[str, tuple[float, float, float, float] | None, float | None]):
+    """Just what warned_for reads of a GroundTruth: each person's name, box and time to
+    collision (None: not on a collision course)."""
     return SimpleNamespace(
-        people=tuple(SimpleNamespace(name=n, box=b, collision=c) for n, b, c in people)
+        people=tuple(SimpleNamespace(name=n, box=b, time_to_collision=t) for n, b, t in people)
     )
 
 
 def test_a_warning_is_for_the_person_its_track_overlaps_or_for_nobody():
     truth = _truth(
-        ("child", (100.0, 100.0, 140.0, 220.0), True),
-        ("adult", (300.0, 60.0, 360.0, 240.0), False),
+        ("child", (100.0, 100.0, 140.0, 220.0), 2.5),  # beyond a 1.5 s horizon: still on course
+        ("adult", (300.0, 60.0, 360.0, 240.0), None),
     )
     boxes = {3: (102.0, 98.0, 141.0, 218.0), 5: (298.0, 65.0, 358.0, 238.0), 8: (500, 50, 540, 150)}
     child = warned_for(_result(3, boxes), truth)  # type: ignore[arg-type]
     assert child is not None and (child.name, child.track, child.on_course) == ("child", 3, True)
-    assert not child.wrong and child.said() == "child (track 3, on a collision course)"
+    assert (
+        not child.wrong
+        and child.said() == "child (track 3, on a collision course, contact in 2.50 s)"
+    )
     adult = warned_for(_result(5, boxes), truth)  # type: ignore[arg-type]
     assert adult is not None and adult.name == "adult" and adult.wrong
     assert adult.said() == "adult (track 5, not on a collision course)"
@@ -62,7 +66,7 @@ def test_a_warning_is_for_the_person_its_track_overlaps_or_for_nobody():
 
 
 def test_two_tracks_on_one_person_the_better_overlap_is_them_the_other_nobody():
-    truth = _truth(("child", (100.0, 100.0, 140.0, 220.0), True))
+    truth = _truth(("child", (100.0, 100.0, 140.0, 220.0), 1.0))
     boxes = {1: (100.0, 100.0, 140.0, 220.0), 2: (95.0, 110.0, 135.0, 230.0)}
     assert warned_for(_result(1, boxes), truth).name == "child"  # type: ignore[arg-type,union-attr]
     assert warned_for(_result(2, boxes), truth).name == NOBODY  # type: ignore[arg-type,union-attr]
@@ -84,14 +88,15 @@ def _runs() -> list[LoopOutcome]:
                      impact_speed=2.0 if s < 2 else None, min_gap=0.0 if s < 2 else 1.0,
                      people=2) for s in range(4)]  # fmt: skip
     who = dict(braked_for_track=2, people=2)
+    child = dict(braked_for="child", braked_for_on_course=True, braked_for_ttc=1.2)
     runs += [
-        _outcome("rules/ground", 0, **BRAKED, **who, braked_for="child", braked_for_on_course=True),
+        _outcome("rules/ground", 0, **BRAKED, **who, **child),
         # avoided the contact, but braking for the adult on the kerb: luck, not right
         _outcome(
             "rules/ground", 1, **BRAKED, **who, braked_for="adult", braked_for_on_course=False
         ),
         _outcome("rules/ground", 2, **BRAKED, **who, braked_for=NOBODY, braked_for_on_course=False),
-        _outcome("rules/ground", 3, **BRAKED, **who, braked_for="child", braked_for_on_course=True),
+        _outcome("rules/ground", 3, **BRAKED, **who, **child),
     ]
     return runs
 
@@ -113,7 +118,12 @@ def test_brakes_for_the_wrong_person_are_counted_apart_and_listed_with_the_perso
     column = cells.index("braked for the wrong person")
     ground_line = next(line for line in lines if line.startswith("| rules/ground "))
     assert ground_line.strip("|").split("|")[column].strip() == "2"
-    assert "adult (track 2, not on a collision course)" in format_runs(runs)
+    shown = format_runs(runs)
+    assert "| adult (track 2, not on a collision course) |" in shown
+    assert "| child (track 2, on a collision course, contact in 1.20 s) |" in shown
+    assert replace(runs[4], braked_for_ttc=None).braked_for_said() == (
+        "braked for child (track 2, on a collision course)"
+    )
 
 
 def test_runs_that_name_no_one_give_the_tables_they_always_gave():
