@@ -10,7 +10,9 @@ world, topdown, truth, ttc, alarm, robot):
 - camera/people/{id}       everyone seen, one entity per identity: box (labelled with id
                            and case), pose, prediction; cleared when the person is gone
 - features/{phi,vx,vy}     time series; latency/{stage} per-stage milliseconds
-- events                   the warning's onset and end, each line starting with its time
+- events                   the warning's onset and end, each line starting with its time;
+                           the onset names the person it is for (their id and box colour),
+                           and a warning that passes to another person says so
 Frames are indexed on the `frame` timeline and on `time` (seconds of the stream).
 The file appears whole or not at all: it is written under a temporary name (monopic.output)
 and renamed by `close()`; `abort()`, or a failed `close()`, deletes it, and a killed
@@ -41,7 +43,7 @@ import rerun.blueprint as rrb
 
 from monopic.closing import WholeOrNothing
 from monopic.output import remove_stale_temporaries, temporary_sibling
-from monopic.people.colour import person_colour
+from monopic.people.colour import person_colour, person_colour_name
 from monopic.pipeline import FrameResult
 from monopic.pose.skeleton import CONNECTIONS, LANDMARK_NAMES
 from monopic.rerun_file import release, save_with_blueprint
@@ -151,6 +153,14 @@ def skeleton_context(label: str, colour: tuple[int, int, int]) -> rr.AnnotationC
     )
 
 
+def _person_said(person_id: int | None) -> str:
+    """'id 3 (violet box)': the person a warning is for, as camera/people draws them
+    ('' when the warning names no one)."""
+    if person_id is None:
+        return ""
+    return f"id {person_id} ({person_colour_name(person_id)} box)"
+
+
 class RunRecording(WholeOrNothing):
     """Writes one run to a .rrd file."""
 
@@ -170,6 +180,7 @@ class RunRecording(WholeOrNothing):
         self.started = False
         self.time = 0.0  # seconds of the frame being logged
         self._warned = False  # the primary predictor's warning on the last processed frame
+        self._warned_id: int | None = None  # the person that warning was for
         if layout is not None:
             self.start(layout)
         skeleton = skeleton_context("person", PIPELINE_COLOUR)
@@ -204,9 +215,15 @@ class RunRecording(WholeOrNothing):
         self.rec.set_time("time", duration=timestamp)
         self.time = timestamp
 
-    def log_event(self, text: str, level: str = rr.TextLogLevel.INFO) -> None:
-        """A line in the events view at the current time: "2.07 s  text"."""
-        self.rec.log("events", rr.TextLog(f"{self.time:.2f} s  {text}", level=level))
+    def log_event(
+        self,
+        text: str,
+        level: str = rr.TextLogLevel.INFO,
+        colour: tuple[int, int, int] | None = None,
+    ) -> None:
+        """A line in the events view at the current time: "2.07 s  text" (in `colour`:
+        a person's, for a line about them)."""
+        self.rec.log("events", rr.TextLog(f"{self.time:.2f} s  {text}", level=level, color=colour))
 
     def log_image(self, image: np.ndarray, entity: str = "camera/image") -> None:
         """An RGB image, JPEG-compressed, at the current time (the first one starts the file)."""
@@ -234,19 +251,28 @@ class RunRecording(WholeOrNothing):
         if w is not None:
             zone = np.vstack([w.zone, w.zone[:1]])
             rec.log("camera/zone", rr.LineStrips2D([zone], colors=[RISK_COLOURS[w.risk]]))
+            who = _person_said(result.person_id)
+            pid = result.person_id
+            colour = person_colour(pid) if pid is not None else None
             if w.collision and not self._warned:
-                who = f"id {result.person_id}, " if result.person_id is not None else ""
                 self.log_event(
-                    f"COLLISION IMMINENT ({result.primary}): {who}case {int(p.case)} "
-                    f"({p.case.label})",
+                    f"COLLISION IMMINENT ({result.primary}): {who + ', ' if who else ''}"
+                    f"case {int(p.case)} ({p.case.label})",
                     rr.TextLogLevel.WARN,
+                    colour,
+                )
+            elif w.collision and pid is not None and pid != self._warned_id:
+                self.log_event(
+                    f"warning now for {who} ({result.primary})", rr.TextLogLevel.WARN, colour
                 )
             elif self._warned and not w.collision:
                 self.log_event(f"warning cleared ({result.primary})")
             self._warned = w.collision
+            self._warned_id = result.person_id if w.collision else None
         else:
             rec.log("camera/zone", rr.Clear(recursive=False))
             self._warned = False
+            self._warned_id = None
         if p is not None and f is not None:
             colour = predictor_colour(result.primary)
             rec.log(

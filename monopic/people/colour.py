@@ -10,5 +10,15 @@ PERSON_COLOURS = (
 )  # fmt: skip
 
 
+# Their names, so a text (a recording's warning event) points at the box of that colour.
+COLOUR_NAMES = ("sky blue", "orange", "violet", "pale yellow", "mint", "pink", "light blue",
+                "tan")  # fmt: skip
+
+
 def person_colour(person_id: int) -> tuple[int, int, int]:
     return PERSON_COLOURS[person_id % len(PERSON_COLOURS)]
+
+
+def person_colour_name(person_id: int) -> str:
+    """The name of `person_colour(person_id)`."""
+    return COLOUR_NAMES[person_id % len(COLOUR_NAMES)]

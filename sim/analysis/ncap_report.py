@@ -6,7 +6,9 @@ virtual tests show at worst. Its verification value is the mean of its verificat
 runs (one by default), run apart from the prediction's. The calculator (sim.analysis.
 ncap_score) turns predictions and verification values into points; this module writes
 what it said beside the project's own figures: impact speed, speed reduction and warning
-TTC per grid point (worst and mean), recall and lead time, and the near misses' braking.
+TTC per grid point (worst and mean), recall and lead time, the near misses' braking, and
+where runs name whom the car braked for (the people tracker, several people), the brakes
+for the wrong person (nobody, or someone not on a collision course) apart from the right.
 """
 
 from __future__ import annotations
@@ -25,6 +27,7 @@ from sim.analysis.ncap_score import CalculatorScore, Cell, band_colour, percent
 from sim.analysis.triage import Rerunning, ncap_triage_lines
 from sim.runs.ncap_grid import DECLARED, GRID, MEASURED, NEAR_MISS, VERIFY, LatencySetting
 from sim.scenario.ncap import CarSpec, Protocol
+from sim.world.warned_for import NOBODY
 
 COLOURS = {  # the calculator's own RGB (common.PREDICTION_COLOR_MAP)
     "Green": (0 / 255, 153 / 255, 51 / 255),
@@ -153,6 +156,61 @@ def near_misses(rows: Sequence[dict[str, Any]]) -> list[NearMissSummary]:
         )
         for policy, rs in by.items()
     ]
+
+
+@dataclass(frozen=True)
+class BrakedFor:
+    """One policy's braked runs by whom the car braked for (runs that name it only)."""
+
+    policy: str
+    braked: int  # braked runs that name whom they braked for
+    right: int  # for someone on a collision course then
+    bystander: int  # for someone not on a collision course
+    nobody: int  # for a phantom track
+
+    @property
+    def wrong(self) -> int:
+        return self.bystander + self.nobody
+
+
+def braked_for(rows: Sequence[dict[str, Any]]) -> list[BrakedFor]:
+    """Per policy (in the rows' order), the braked runs counted by whom they braked for;
+    empty when no row names it (one-tracker runs of one person do not)."""
+    by: dict[str, list[dict[str, Any]]] = defaultdict(list)
+    for row in rows:
+        o = row["outcome"]
+        if o["brake_time"] is not None and o.get("braked_for") is not None:
+            by[row["policy"]].append(o)
+    out = []
+    for policy, os_ in by.items():
+        nobody = sum(o["braked_for"] == NOBODY for o in os_)
+        right = sum(o["braked_for"] != NOBODY and bool(o.get("braked_for_on_course")) for o in os_)
+        out.append(BrakedFor(policy, len(os_), right, len(os_) - right - nobody, nobody))
+    return out
+
+
+def braked_for_lines(rows: Sequence[dict[str, Any]]) -> list[str]:
+    """The report's section on whom the car braked for (none when no row names it)."""
+    counts = braked_for(rows)
+    if not counts:
+        return []
+    lines = [
+        "## Whom the car braked for",
+        "",
+        "At the frame whose warning made the brake act, the warned track matched to the "
+        "truth's people by box overlap: braking for the wrong person is braking for someone "
+        "not on a collision course then (the footprints would not meet at constant speeds), "
+        "or for nobody (a track that is no one).",
+        "",
+        "| policy | braked | for the person on course | wrong person | of them: someone "
+        "else | of them: nobody |",
+        "|" + " --- |" * 6,
+    ]
+    for c in counts:
+        lines.append(
+            f"| {c.policy} | {c.braked} | {c.right} | {c.wrong} | {c.bystander} | {c.nobody} |"
+        )
+    return [*lines, ""]
 
 
 @dataclass(frozen=True)
@@ -386,7 +444,8 @@ def render(
     ]
     for nm in near_misses(rows):
         lines.append(f"| {nm.policy} | {nm.runs} | {nm.braked} | {nm.warned} | {nm.contacts} |")
-    lines += ["", *ncap_triage_lines(rows, Rerunning(out / RESULTS, out, out))]
+    lines += ["", *braked_for_lines(rows)]
+    lines += [*ncap_triage_lines(rows, Rerunning(out / RESULTS, out, out))]
     lines += [
         "## How the runs were made",
         "",

@@ -33,6 +33,13 @@ DEFAULT_POLICIES = "none,truth,rules/image,rules/ground"
 MEET_TIME = 3.0  # s: --cases crossings meet the robot then unless it brakes
 CASE_SPEEDS = "1,2,3"  # m/s: --cases has no file to take a speed from
 DEFAULT_RESULTS = Path("recordings/closed-loop.jsonl")
+TRACKERS = ("one", "everyone")  # sim.runs.run_spec.TRACKERS (imported when the command runs)
+TRACKER_HELP = (
+    "whom the policy's pipeline follows: 'one' pedestrian (the one-pedestrian tracker, the "
+    "default: every earlier figure is made with it) or 'everyone' in view (the people "
+    "tracker: the brake acts on the worst person's warning); each run names whom the car "
+    "braked for"
+)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -45,7 +52,10 @@ def register(sub: argparse._SubParsersAction) -> None:
         "predictor warns; the command acts after the pipeline's measured latency, at the "
         "next frame boundary). Prints contact rate, impact speed and minimum footprint gap "
         "per policy, and the runs to look at (a braking policy's contacts, its needless "
-        "stops) each with the `monopic rerun` command that runs it again into a recording. "
+        "stops, and its brakes for the wrong person: for nobody or for someone not on a "
+        "collision course, named where a run names whom it braked for, i.e. with --tracker "
+        "everyone or several people) each with the `monopic rerun` command that runs it "
+        "again into a recording. "
         "Default scenarios: the small-robot Euro NCAP-style collision families "
         f"({', '.join(NCAP_FAMILIES)} in {FAMILY_FOLDER}). A scenario file (a default family "
         "too) runs at its own robot speed and seed unless --robot-speeds or --seed replace "
@@ -99,6 +109,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="results file, one line per finished run, resumable (default: beside --out "
         f"as <out>.jsonl; without --out {DEFAULT_RESULTS})",
     )
+    p.add_argument("--tracker", choices=TRACKERS, default="one", help=TRACKER_HELP)
     p.add_argument("--rrd-dir", type=Path, help="record every braking run into this folder")
     add_executor_options(p)
     p.add_argument(
@@ -187,7 +198,7 @@ def run(args: argparse.Namespace) -> int:
         if args.latency_ms is None
         else LatencySetting(FIXED, float(args.latency_ms))
     )
-    runs = grid.expand(sources, scenarios, policies, latency, args.rrd_dir)
+    runs = grid.expand(sources, scenarios, policies, latency, args.rrd_dir, args.tracker)
     executor = make_executor(args, run=grid.work)
     with logs_above_the_bar(args.executor, args.address), _temporaries_cleared(args.rrd_dir):
         outcome = grid.run_runs(runs, results, executor)
@@ -205,11 +216,13 @@ def run(args: argparse.Namespace) -> int:
         seeds = "--seed"
     else:
         seeds = "the --cases default" if args.cases else "each file's own"
+    # The default tracker goes unsaid, so the tables it makes read as they always did.
+    followed = "" if args.tracker == "one" else ", the people tracker (everyone in view)"
     ran_on = (
         f"{len(scenarios)} scenarios ({source}; robot speeds {_speeds_seen(scenarios)} m/s: "
         f"{chosen}), seed {_seeds_seen(scenarios)} ({seeds}), {cam.width}x{cam.height} frames "
         f"at {1 / scenarios[0].dt:.0f} fps, "
-        f"horizon {scenarios[0].horizon:g} s, latency {latency.describe()}; "
+        f"horizon {scenarios[0].horizon:g} s, latency {latency.describe()}{followed}; "
         f"{platform.processor() or platform.machine()}, {platform.node()}"
     )
     table = format_table(summarise(outcomes))

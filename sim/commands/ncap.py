@@ -21,6 +21,7 @@ PROTOCOL = Path("scenarios/ncap/protocol.toml")
 CAR = Path("scenarios/ncap/car.toml")
 # The protocol's day tests this grid runs, by their protocol.toml names (a test checks).
 TESTS = ("cpna", "cpfa", "cpnco", "cpla")
+TRACKERS = ("one", "everyone")  # sim.runs.run_spec.TRACKERS (imported when the command runs)
 LEFT_UNSCORED = (
     "CPNA, CPFA, CPNCO and CPLA at night (their night matrices are filled Red: not run, "
     "no claim); CPTA (turning: needs a robot that turns and a truth that follows it); the "
@@ -82,6 +83,15 @@ def register(sub: argparse._SubParsersAction) -> None:
         action="store_true",
         help="apply the pipeline's latency measured on this host per frame instead of the "
         "declared one (the score then moves with the host's speed and load)",
+    )
+    p.add_argument(
+        "--tracker",
+        choices=TRACKERS,
+        default="one",
+        help="whom the policy's pipeline follows: 'one' pedestrian (the one-pedestrian "
+        "tracker, the default: every earlier rating is made with it) or 'everyone' in view "
+        "(the people tracker: the car brakes on the worst person's warning); each run names "
+        "whom the car braked for",
     )
     add_executor_options(p)
     p.add_argument("--restart", action="store_true", help="set aside other code's results")
@@ -166,6 +176,7 @@ def run(args: argparse.Namespace) -> int:
     runs = ncap_grid.expand(
         protocol, car, tests, list(policies), quick=args.quick, speeds=speeds,
         seeds=args.runs_per_point, near_misses=not args.no_near_misses, latency=latency,
+        tracker=args.tracker,
     )  # fmt: skip
     output_folder(args.out, "--out")
     results = args.out / "results.jsonl"
@@ -240,5 +251,7 @@ def _command(args: argparse.Namespace) -> str:
         parts.append(f"--latency-ms {args.latency_ms:g}")
     if args.measured_latency:
         parts.append("--measured-latency")
+    if args.tracker != "one":
+        parts.append(f"--tracker {args.tracker}")
     parts.append(f"--out {args.out}")
     return " ".join(parts)

@@ -26,7 +26,10 @@ really going to happen) reads at a glance. Entities added to RunRecording's:
   against the truth at a glance; robot/speed and truth/gap (footprint distance),
   brake/command (closed loop);
 - events: first frame on a collision course, contact, pose found and lost, each
-  predictor's warning onset, and whatever the caller adds (`log_event`).
+  predictor's warning onset, whom the robot's warning is for by the truth (at its onset
+  and whenever it passes to another track: the track's id and box colour, the person it
+  is matched to, sim.world.warned_for, or nobody, and whether they are on a collision
+  course), and whatever the caller adds (`log_event`).
 
 `SimRecording` is the per-frame API a runner calls (the sweep can record every run and
 keep only the ones that went wrong: `close()` keeps the file, `abort()` drops it);
@@ -49,6 +52,7 @@ import rerun as rr
 import rerun.blueprint as rrb
 
 from monopic.closing import WholeOrNothing
+from monopic.people.colour import person_colour
 from monopic.pipeline import FrameResult
 from monopic.pose.skeleton import LANDMARK_NAMES
 from monopic.predict.base import Mode
@@ -67,6 +71,7 @@ from monopic.variants.zone import swept_ground_zone
 from sim.recording.topdown import TopDownCamera
 from sim.scenario.spec import Scenario
 from sim.world.ground_truth import GroundTruth, footprint_gap, footprints
+from sim.world.warned_for import warned_for
 from sim.world.world import World, WorldStep
 
 TRUTH_COLOUR = (0, 210, 255)
@@ -281,6 +286,7 @@ class SimRecording(WholeOrNothing):
         self._was_colliding = False
         self._contact_logged = False
         self._warning: dict[str, bool] = {}
+        self._warned_track: int | None = None  # the track the robot's warning is for
         self._drawn: set[str] = set()  # predictors with a prediction in the world view
         self._styled: set[str] = set()  # predictors whose series and lane have their style
         self._lanes: dict[str, str] = {}  # entity -> state last logged on its lane
@@ -455,6 +461,7 @@ class SimRecording(WholeOrNothing):
             self._log_people(truth)
         self._log_series(truth)
         self._log_events(step, result)
+        self._log_warned_for(truth, result)
         if self.topdown_every and step.index % self.topdown_every == 0 and self.world.road:
             if self._topdown is None:
                 self._topdown = TopDownCamera(self.world)
@@ -738,6 +745,24 @@ class SimRecording(WholeOrNothing):
         for key, was in list(self._warning.items()):
             if was and result.decision(key) is None:
                 self._warning[key] = False
+
+    def _log_warned_for(self, truth: GroundTruth, result: FrameResult | None) -> None:
+        """Whom the robot's warning is for, by the truth: at its onset and whenever it
+        passes to another track (the events view, in that track's box colour)."""
+        warning = result.warning if result is not None else None
+        if result is None or warning is None or not warning.collision:
+            self._warned_track = None
+            return
+        if result.person_id is None or result.person_id == self._warned_track:
+            return
+        self._warned_track = result.person_id
+        who = warned_for(result, truth)
+        assert who is not None  # a person id was given
+        self.run.log_event(
+            f"truth: the warning ({result.primary}) is for {who.said()}",
+            rr.TextLogLevel.WARN,
+            colour=person_colour(result.person_id),
+        )
 
     # -- finishing -----------------------------------------------------------------------
 

@@ -14,7 +14,10 @@ the mean of the continuous jerk-limited profile over it, so the car's speed at e
 frame is exactly that of the continuous profile, whatever the frame rate.
 
 `run_aeb` is one closed-loop run of a scenario under a policy ("rules/ground", ...) with
-this brake, in the one run loop (sim.runs.loop) and seeded as the closed loop is.
+this brake, in the one run loop (sim.runs.loop) and seeded as the closed loop is, its
+pipeline following one pedestrian or everyone (`tracker`); like the closed loop's, its
+outcome names whom the car braked for (the person of the warning the brake acted on,
+sim.world.warned_for).
 
 Latency: a fixed figure (what a real-time implementation guarantees; `monopic ncap`
 applies the car file's declared one by default, so that a rating is a property of the
@@ -35,12 +38,22 @@ from pathlib import Path
 import numpy as np
 
 from sim.recording.sim_recording import SimRecording
-from sim.runs.closed_loop import POLICY, LoopLog, policy_pipeline, world_seed
+from sim.runs.closed_loop import (
+    NOBODY,
+    POLICY,
+    LoopLog,
+    braked_for_fields,
+    frame_warned_for,
+    policy_pipeline,
+    world_seed,
+)
 from sim.runs.latency import AppliedLatency
 from sim.runs.loop import Listener, LoopFrame, OnBoard, Progress, run_loop
+from sim.runs.run_spec import ONE
 from sim.scenario.spec import Scenario
 from sim.world.ground_truth import pedestrian_passed
 from sim.world.render import RenderContext
+from sim.world.warned_for import WarnedFor
 from sim.world.world import World, WorldStep
 
 
@@ -120,6 +133,8 @@ class AebController:
     warned_frames: int = 0
     first_warning_frame: int | None = None
     warning_ttc: float | None = None  # s to collision when the FCW was issued
+    policy: str = ""
+    acted: WarnedFor | None = None  # whom the warning the brake acts on was for
 
     def action(self, frame: LoopFrame) -> float:
         result = frame.results.get(POLICY)
@@ -133,7 +148,10 @@ class AebController:
                 self.first_warning_frame = frame.index
                 ttc = frame.truth.pedestrian.time_to_collision  # at constant speeds, as NCAP's TTC
                 self.warning_ttc = None if ttc is None else max(0.0, float(ttc) - latency)
+        before = self.brake.warning_time
         self.brake.observe(frame.truth.time, warned, latency)
+        if self.brake.warning_time != before:  # this frame's warning is now the one acting
+            self.acted = frame_warned_for(frame, self.policy)
         return self.brake.action(frame.truth.time)
 
 
@@ -172,10 +190,24 @@ class AebOutcome:
     # The pipeline's measured latency of every processed frame, ms (what a replay of a
     # run made with the measured latency passes back as `latencies_ms`).
     latencies_ms: tuple[float, ...] = field(repr=False, default=())
+    # Whom the brake acted for, as the closed loop's LoopOutcome says it (written only
+    # for the people tracker or several people: sim.runs.closed_loop.OPTIONAL).
+    braked_for: str | None = None
+    braked_for_track: int | None = None
+    braked_for_on_course: bool | None = None
+    people: int = 1
+    braked_for_ttc: float | None = None
 
     @property
     def braked(self) -> bool:
         return self.brake_time is not None
+
+    @property
+    def wrong_person(self) -> bool:
+        """Braked for nobody or for someone not on a collision course."""
+        return self.braked_for is not None and (
+            self.braked_for == NOBODY or self.braked_for_on_course is False
+        )
 
 
 def run_aeb(
@@ -188,18 +220,20 @@ def run_aeb(
     on_frame: Callable[[int], None] | None = None,
     latencies_ms: Sequence[float] | None = None,
     rrd: Path | None = None,
+    tracker: str = ONE,
 ) -> AebOutcome:
     """One closed-loop run of `scenario` with the pipeline of `policy` and this AEB.
 
     `latencies_ms`: the per-frame latencies to apply instead of the measured ones (a
     replay: an earlier outcome's `latencies_ms`, with `params.latency_ms` None); a replay
     that processes another number of frames raises ValueError. `rrd` records the run (as
-    the closed loop records one: sim.runs.closed_loop.LoopLog).
+    the closed loop records one: sim.runs.closed_loop.LoopLog). `tracker`: whom the
+    pipeline follows (sim.runs.run_spec.TRACKERS).
     """
     latency = AppliedLatency(params.latency_ms, latencies_ms)
-    onboard = [OnBoard(POLICY, policy_pipeline(scenario, policy))]
+    onboard = [OnBoard(POLICY, policy_pipeline(scenario, policy, tracker))]
     brake = JerkLimitedBrake(scenario.dt, params)
-    controller = AebController(brake, latency)
+    controller = AebController(brake, latency, policy=policy)
     robot, footprint = scenario.robot, scenario.pedestrian.footprint
 
     def over(step: WorldStep) -> bool:
@@ -212,7 +246,7 @@ def run_aeb(
     with World(scenario, render=True, render_context=render_context) as world:
         recording = SimRecording(rrd, world) if rrd is not None else None
         with recording if recording is not None else nullcontext():
-            log = LoopLog(footprint, policy, recording)
+            log = LoopLog(footprint, policy, recording, lambda: controller.acted)
             pitch = PitchLog(world)
             listeners: list[Listener] = [log, pitch]
             if on_frame is not None:
@@ -250,4 +284,6 @@ def run_aeb(
         warned_frames=controller.warned_frames,
         latency_ms_median=float(np.median(lat)) if lat else None,
         latencies_ms=tuple(lat),
+        **braked_for_fields(controller.acted if log.brake_time is not None else None),
+        people=log.people,
     )

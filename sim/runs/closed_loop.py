@@ -24,7 +24,14 @@ The pipeline processes every frame even when L > dt (a real robot would drop fra
 
 Per run: contact (footprints meet, sim.world.ground_truth), the robot's speed at contact
 (impact speed), the smallest gap between the footprints, when the first warning came and
-when the brake acted.
+when the brake acted, and whom the car braked for: at the frame whose warning made the
+brake act (the warning that acted first, LatencyBrake), the warned person's track matched
+to the truth's people (sim.world.warned_for): their name or "nobody" (a phantom), and
+whether they were on a collision course then. The pipeline follows one pedestrian or
+everyone in view (`tracker`, sim.runs.run_spec.TRACKERS); with everyone, the warning the
+brake acts on is the worst person's (monopic.pipeline.worst_for). A brake for nobody or
+for someone not on a collision course is braking for the wrong person, counted apart from
+right braking (a needless stop that braked for a bystander is the wrong person's).
 """
 
 from __future__ import annotations
@@ -32,8 +39,9 @@ from __future__ import annotations
 import math
 from collections.abc import Callable, Sequence
 from contextlib import nullcontext
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
 
 import gymnasium
 import numpy as np
@@ -44,9 +52,11 @@ from monopic.predict.registry import make_predictor, predictor_names
 from sim.recording.sim_recording import SimRecording
 from sim.runs.latency import AppliedLatency
 from sim.runs.loop import Listener, LoopEnd, LoopFrame, OnBoard, Progress, run_loop
+from sim.runs.run_spec import ONE
 from sim.scenario.spec import Scenario
 from sim.world.ground_truth import footprint_gap, pedestrian_passed
 from sim.world.render import RenderContext
+from sim.world.warned_for import NOBODY, WarnedFor, oracle_warned_for, warned_for
 from sim.world.world import World, WorldStep
 
 NO_BRAKE = "none"
@@ -74,10 +84,48 @@ class LoopOutcome:
     # run made with the measured latency passes back as `latencies_ms`).
     latencies_ms: tuple[float, ...] = field(repr=False, default=())
     delays: tuple[int, ...] = field(repr=False, default=())  # frames, per warned frame
+    # Whom the brake acted for (sim.world.warned_for), None when it did not brake or the
+    # line predates it; written only for the people tracker or several people (OPTIONAL).
+    braked_for: str | None = None  # the truth's name, or NOBODY (a phantom)
+    braked_for_track: int | None = None  # the pipeline's person id (None: the oracle)
+    braked_for_on_course: bool | None = None  # on a collision course at that frame
+    people: int = 1  # people in the scenario
+    braked_for_ttc: float | None = None  # s, that person's true time to collision then
 
     @property
     def braked(self) -> bool:
         return self.brake_time is not None
+
+    @property
+    def wrong_person(self) -> bool:
+        """Braked for nobody or for someone not on a collision course (known only where
+        the run names whom it braked for)."""
+        return self.braked_for is not None and (
+            self.braked_for == NOBODY or self.braked_for_on_course is False
+        )
+
+    def braked_for_said(self) -> str | None:
+        """'braked for adult (track 3, not on a collision course)', None if unnamed."""
+        if self.braked_for is None:
+            return None
+        ttc = self.braked_for_ttc if self.braked_for_on_course else None
+        if self.braked_for_on_course and ttc is None:  # a line without the time
+            ttc = math.nan
+        return f"braked for {WarnedFor(self.braked_for_track, self.braked_for, ttc).said()}"
+
+
+# The outcome's fields a run writes only with the people tracker or several people, so a
+# one-tracker run of one person writes the line it always wrote (sim.runs.result's rule).
+OPTIONAL = ("braked_for", "braked_for_track", "braked_for_on_course", "people", "braked_for_ttc")
+
+
+def outcome_json(outcome: LoopOutcome | Any, tracker: str) -> dict[str, Any]:
+    """A closed-loop or AEB outcome as its result line holds it (OPTIONAL's rule)."""
+    data = asdict(outcome)
+    if tracker == ONE and outcome.people <= 1:
+        for key in OPTIONAL:
+            data.pop(key, None)
+    return data
 
 
 class LatencyBrake:
@@ -143,13 +191,22 @@ def check_policy(policy: str) -> None:
         raise ValueError(f"{policy!r} is not a policy: use {policy_choices()}")
 
 
-def policy_pipeline(scenario: Scenario, policy: str) -> Pipeline:
-    """A pipeline whose primary (only) predictor is the policy's, e.g. 'rules/ground'."""
+def policy_pipeline(scenario: Scenario, policy: str, tracker: str = ONE) -> Pipeline:
+    """A pipeline whose primary (only) predictor is the policy's, e.g. 'rules/ground',
+    following one pedestrian or everyone (`tracker`, sim.runs.run_spec.TRACKERS)."""
     from sim.runs.pipelines import scenario_pipeline
 
     check_policy(policy)
     name, _, mode = policy.partition("/")
-    return scenario_pipeline(scenario, [make_predictor(name, Mode(mode))])
+    return scenario_pipeline(scenario, [make_predictor(name, Mode(mode))], follows=tracker)
+
+
+def frame_warned_for(frame: LoopFrame, policy: str) -> WarnedFor | None:
+    """Whom the policy's warning on this frame was for (None: it names no one)."""
+    result = frame.results.get(POLICY)
+    if result is not None:
+        return warned_for(result, frame.truth)
+    return oracle_warned_for(frame.truth) if policy == ORACLE else None
 
 
 def world_seed(seed: int) -> int:
@@ -168,6 +225,7 @@ class BrakeController:
     latency: AppliedLatency
     warned_frames: int = 0
     first_warning_time: float | None = None
+    acted: WarnedFor | None = None  # whom the warning the brake acts on was for
 
     def action(self, frame: LoopFrame) -> float:
         truth = frame.truth
@@ -184,7 +242,10 @@ class BrakeController:
         self.warned_frames += int(warned)
         if warned and self.first_warning_time is None:
             self.first_warning_time = truth.time
+        before = self.brake.brake_from
         self.brake.observe(frame.index, warned, latency)
+        if self.brake.brake_from != before:  # this frame's warning is now the one acting
+            self.acted = frame_warned_for(frame, self.policy)
         return self.brake.action(frame.index)
 
 
@@ -195,6 +256,8 @@ class LoopLog(Listener):
     footprint: float
     policy: str
     recording: SimRecording | None = None
+    # Whom the brake acts for, asked when it first acts (the controller's `acted`).
+    acted: Callable[[], WarnedFor | None] | None = None
     min_gap: float = math.inf
     contact_time: float | None = None
     impact_speed: float | None = None
@@ -202,11 +265,13 @@ class LoopLog(Listener):
     start_speed: float | None = None
     final_speed: float = 0.0
     frames: int = 0
+    people: int = 1
 
     def frame(self, frame: LoopFrame) -> None:
         truth = frame.truth
         if self.start_speed is None:
             self.start_speed = truth.robot.speed
+            self.people = len(truth.people)
         self.min_gap = min(self.min_gap, footprint_gap(truth, self.footprint))
         if truth.pedestrian.contact and self.contact_time is None:
             self.contact_time, self.impact_speed = truth.time, truth.robot.speed
@@ -214,8 +279,11 @@ class LoopLog(Listener):
             self.recording.log_step(frame.step, frame.results.get(POLICY))
             self.recording.log_series("brake/command", frame.action)
             if frame.action and self.brake_time is None:
+                who = self.acted() if self.acted is not None else None
+                said = f", braking for {who.said()}" if who is not None else ""
                 self.recording.log_event(
-                    f"BRAKE at {-frame.action:g} m/s^2 from this frame ({self.policy})", "WARN"
+                    f"BRAKE at {-frame.action:g} m/s^2 from this frame ({self.policy}{said})",
+                    "WARN",
                 )
         if frame.action and self.brake_time is None:
             self.brake_time = truth.time
@@ -239,8 +307,10 @@ def run_closed_loop(
     on_frame: Callable[[int], None] | None = None,
     latencies_ms: Sequence[float] | None = None,
     render_context: RenderContext | None = None,
+    tracker: str = ONE,
 ) -> LoopOutcome:
-    """One run of `scenario` under `policy` (see the module docstring).
+    """One run of `scenario` under `policy` (see the module docstring), its pipeline
+    following one pedestrian or everyone (`tracker`).
 
     `latency_ms` None applies the pipeline's measured latency per frame (the oracle has
     none); a number applies that fixed latency instead. `latencies_ms` replays an earlier
@@ -251,7 +321,7 @@ def run_closed_loop(
     latency = AppliedLatency(latency_ms, latencies_ms)
     onboard = []
     if policy not in (NO_BRAKE, ORACLE):
-        onboard.append(OnBoard(POLICY, policy_pipeline(scenario, policy)))
+        onboard.append(OnBoard(POLICY, policy_pipeline(scenario, policy, tracker)))
     controller = BrakeController(
         policy, LatencyBrake(scenario.dt, scenario.robot.max_deceleration), latency
     )
@@ -266,7 +336,7 @@ def run_closed_loop(
     with World(scenario, render=True, render_context=render_context) as world:
         recording = SimRecording(rrd, world) if rrd is not None else None
         with recording if recording is not None else nullcontext():
-            log = LoopLog(footprint, policy, recording)
+            log = LoopLog(footprint, policy, recording, lambda: controller.acted)
             listeners: list[Listener] = [log]
             if on_frame is not None:
                 listeners.append(Progress(on_frame))
@@ -295,7 +365,21 @@ def run_closed_loop(
         final_speed=log.final_speed,
         latencies_ms=tuple(latency.measured),
         delays=tuple(controller.brake.delays),
+        **braked_for_fields(controller.acted if log.brake_time is not None else None),
+        people=log.people,
     )
+
+
+def braked_for_fields(acted: WarnedFor | None) -> dict[str, Any]:
+    """An outcome's braked_for fields from whom the acting warning was for."""
+    if acted is None:
+        return {}
+    return {
+        "braked_for": acted.name,
+        "braked_for_track": acted.track,
+        "braked_for_on_course": acted.on_course,
+        "braked_for_ttc": acted.ttc,
+    }
 
 
 # -- the comparison table ---------------------------------------------------------------
@@ -318,6 +402,9 @@ class PolicyRow:
     needless_stops: int | None  # braked in runs the baseline finished without contact
     latency_ms_median: float | None
     delay_frames_median: float | None
+    # Braked for nobody or someone not on a collision course (None: no run of the policy
+    # names whom it braked for, e.g. one-tracker runs of one person).
+    wrong_person: int | None = None
 
 
 def summarise(outcomes: Sequence[LoopOutcome]) -> list[PolicyRow]:
@@ -341,6 +428,7 @@ def summarise(outcomes: Sequence[LoopOutcome]) -> list[PolicyRow]:
             needless = sum(runs[key].braked for key in clear)
         lat = [v for o in runs.values() for v in o.latencies_ms]
         delays = [d for o in runs.values() for d in o.delays]
+        named = [o for o in runs.values() if o.braked_for is not None]
         rows.append(
             PolicyRow(
                 policy=policy,
@@ -356,20 +444,25 @@ def summarise(outcomes: Sequence[LoopOutcome]) -> list[PolicyRow]:
                 needless_stops=needless,
                 latency_ms_median=float(np.median(lat)) if lat else None,
                 delay_frames_median=float(np.median(delays)) if delays else None,
+                wrong_person=sum(o.wrong_person for o in named) if named else None,
             )
         )
     return rows
 
 
 CONTACT, NEEDLESS = "with contact", "braked without need"
-WENT_WRONG = (CONTACT, NEEDLESS)  # also the order of the runs to look at: the worst first
+WRONG_PERSON = "braked for the wrong person"
+# Also the order of the runs to look at: the worst first.
+WENT_WRONG = (CONTACT, WRONG_PERSON, NEEDLESS)
 
 
 def went_wrong(outcomes: Sequence[LoopOutcome]) -> list[str | None]:
-    """Per outcome, CONTACT or NEEDLESS for a braking policy's run that went wrong as the
-    table counts it, else None: contact although the policy brakes, or braked in a run the
-    baseline (same scenario and seed) finished without contact. The baseline's own runs
-    are the reference, never listed."""
+    """Per outcome, CONTACT, WRONG_PERSON or NEEDLESS for a braking policy's run that went
+    wrong as the table counts it, else None: contact although the policy brakes, braked
+    for nobody or someone not on a collision course (LoopOutcome.wrong_person; the
+    outcome's `braked_for_said` names them), or braked in a run the baseline (same
+    scenario and seed) finished without contact. The baseline's own runs are the
+    reference, never listed."""
     baseline = {(o.scenario, o.seed): o for o in outcomes if o.policy == NO_BRAKE}
     out: list[str | None] = []
     for o in outcomes:
@@ -378,6 +471,8 @@ def went_wrong(outcomes: Sequence[LoopOutcome]) -> list[str | None]:
             out.append(None)
         elif o.contact:
             out.append(CONTACT)
+        elif o.braked and o.wrong_person:
+            out.append(WRONG_PERSON)
         elif o.braked and base is not None and not base.contact:
             out.append(NEEDLESS)
         else:
@@ -390,14 +485,20 @@ def _f(x: float | None, fmt: str = ".2f") -> str:
 
 
 def format_table(rows: Sequence[PolicyRow]) -> str:
-    """Markdown table of the comparison."""
+    """Markdown table of the comparison; a column of the brakes for the wrong person when a
+    run names whom it braked for (the people tracker, several people)."""
+    named = any(r.wrong_person is not None for r in rows)
     head = (
         "| policy | runs | contacts | contact rate | baseline contacts avoided | "
         "impact speed mean / max (m/s) | min gap mean / min (m) | braked | "
-        "braked without need | latency median (ms) | brake delay median (frames) |"
+        + ("braked for the wrong person | " if named else "")
+        + "braked without need | latency median (ms) | brake delay median (frames) |"
     )
-    lines = [head, "|" + " --- |" * 11]
+    lines = [head, "|" + " --- |" * (11 + named)]
     for r in rows:
+        wrong = ""
+        if named:
+            wrong = f"| {'-' if r.wrong_person is None else r.wrong_person} "
         avoided = (
             "-"
             if r.avoided is None
@@ -407,7 +508,7 @@ def format_table(rows: Sequence[PolicyRow]) -> str:
         lines.append(
             f"| {r.policy} | {r.runs} | {r.contacts} | {100 * r.contacts / max(r.runs, 1):.0f} % "
             f"| {avoided} | {_f(r.impact_mean)} / {_f(r.impact_max)} "
-            f"| {_f(r.gap_mean)} / {_f(r.gap_min)} | {r.braked} "
+            f"| {_f(r.gap_mean)} / {_f(r.gap_min)} | {r.braked} {wrong}"
             f"| {'-' if r.needless_stops is None else r.needless_stops} "
             f"| {_f(r.latency_ms_median, '.1f')} | {_f(r.delay_frames_median, '.0f')} |"
         )
@@ -415,16 +516,21 @@ def format_table(rows: Sequence[PolicyRow]) -> str:
 
 
 def format_runs(outcomes: Sequence[LoopOutcome]) -> str:
-    """Markdown table, one line per run."""
+    """Markdown table, one line per run; whom each braked for when a run names it."""
+    named = any(o.braked_for is not None for o in outcomes)
     lines = [
         "| scenario | policy | contact | impact speed (m/s) | min gap (m) | first warning (s) "
-        "| brake acts (s) | final speed (m/s) |",
-        "|" + " --- |" * 8,
+        "| brake acts (s) | final speed (m/s) |" + (" braked for |" if named else ""),
+        "|" + " --- |" * (8 + named),
     ]
     for o in outcomes:
+        who = ""
+        if named:
+            said = o.braked_for_said()
+            who = f" {said.removeprefix('braked for ') if said else '-'} |"
         lines.append(
             f"| {o.scenario} | {o.policy} | {'yes' if o.contact else 'no'} "
             f"| {_f(o.impact_speed)} | {o.min_gap:.2f} | {_f(o.first_warning_time)} "
-            f"| {_f(o.brake_time)} | {o.final_speed:.2f} |"
+            f"| {_f(o.brake_time)} | {o.final_speed:.2f} |{who}"
         )
     return "\n".join(lines)

@@ -13,6 +13,12 @@ scenario came from (`source`: the scenario file as given and the values given fo
 the --cases placement), the policy, the seed, the latency applied (`latency`) and the
 pipeline's measured latency of every processed frame (`outcome.latencies_ms`: a run made
 with the measured latency is made again exactly with them).
+
+The tracker (`tracker`: one pedestrian or everyone, sim.runs.run_spec.TRACKERS) is part of
+a run's identity only when it is the people tracker: a one-tracker run keeps the id,
+digest and line it always had (no `tracker` key; the outcome's whom-it-braked-for fields
+only with several people, sim.runs.closed_loop.OPTIONAL), so earlier results files resume
+and compare byte for byte.
 """
 
 from __future__ import annotations
@@ -27,10 +33,11 @@ from typing import Any
 
 from monopic.cases import Case
 from monopic.errors import UserError
-from sim.runs.closed_loop import NO_BRAKE, LoopOutcome, run_closed_loop
+from sim.runs.closed_loop import NO_BRAKE, LoopOutcome, outcome_json, run_closed_loop
 from sim.runs.latency import FIXED, MEASURED, LatencySetting
 from sim.runs.result import values_said
 from sim.runs.results_file import check_resumable, without_keys
+from sim.runs.run_spec import ONE, TRACKERS
 from sim.runs.runner import machine
 from sim.runs.sweep import SweepOutcome, rows_of, run_resumable
 from sim.scenario.files import Given, ScenarioFile, load, placed_case
@@ -168,24 +175,35 @@ class LoopRun:
     rrd: str = ""
     code: str = ""
     replay: tuple[float, ...] | None = None
+    tracker: str = ONE  # whom the policy's pipeline follows (TRACKERS)
 
     def __post_init__(self) -> None:
+        if self.tracker not in TRACKERS:
+            raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}, got {self.tracker!r}")
         if self.latency.source not in (FIXED, MEASURED):
             raise ValueError(f"the closed loop applies a fixed or the measured latency, not "
                              f"{self.latency.describe()}")  # fmt: skip
 
 
-def run_digest(scenario: Scenario, policy: str, latency: LatencySetting) -> str:
-    """8 hex digits of the scenario (seed included), the policy and the latency setting."""
+def run_digest(scenario: Scenario, policy: str, latency: LatencySetting, tracker: str = ONE) -> str:
+    """8 hex digits of the scenario (seed included), the policy, the latency setting and
+    the tracker (the people tracker only: a one-tracker run keeps its digest)."""
     text = f"{scenario_text(replace(scenario, name=''))}|{policy}|{latency.to_json()}"
+    if tracker != ONE:
+        text += f"|tracker={tracker}"
     return hashlib.sha1(text.encode()).hexdigest()[:8]
 
 
 def loop_run(
-    scenario: Scenario, policy: str, source: Source, latency: LatencySetting, rrd: str = ""
+    scenario: Scenario,
+    policy: str,
+    source: Source,
+    latency: LatencySetting,
+    rrd: str = "",
+    tracker: str = ONE,
 ) -> LoopRun:
-    rid = f"{policy}/{scenario.name}-{run_digest(scenario, policy, latency)}"
-    return LoopRun(rid, scenario, policy, source, latency, rrd)
+    rid = f"{policy}/{scenario.name}-{run_digest(scenario, policy, latency, tracker)}"
+    return LoopRun(rid, scenario, policy, source, latency, rrd, tracker=tracker)
 
 
 def expand(
@@ -194,16 +212,18 @@ def expand(
     policies: Sequence[str],
     latency: LatencySetting,
     rrd_dir: Path | None = None,
+    tracker: str = ONE,
 ) -> list[LoopRun]:
-    """Every (scenario, policy) run, scenario by scenario, in the policies' order; with
-    `rrd_dir`, each braking run (not the baseline) records to <scenario>-<policy>.rrd."""
+    """Every (scenario, policy) run, scenario by scenario, in the policies' order, the
+    pipelines following `tracker`; with `rrd_dir`, each braking run (not the baseline)
+    records to <scenario>-<policy>.rrd."""
     runs = []
     for source, scenario in zip(sources, scenarios, strict=True):
         for policy in policies:
             rrd = ""
             if rrd_dir is not None and policy != NO_BRAKE:
                 rrd = str(rrd_dir / f"{scenario.name}-{policy.replace('/', '-')}.rrd")
-            runs.append(loop_run(scenario, policy, source, latency, rrd))
+            runs.append(loop_run(scenario, policy, source, latency, rrd, tracker))
     return runs
 
 
@@ -221,8 +241,9 @@ def work(spec: LoopRun, kept: KeptRenderContext | None = None) -> dict[str, Any]
             rrd=Path(spec.rrd) if spec.rrd else None,
             latencies_ms=spec.replay,
             render_context=context,
+            tracker=spec.tracker,
         )
-        return {
+        row = {
             "schema": SCHEMA,
             "id": spec.id,
             "code": spec.code,
@@ -233,11 +254,14 @@ def work(spec: LoopRun, kept: KeptRenderContext | None = None) -> dict[str, Any]
             "policy": spec.policy,
             "seed": spec.scenario.seed,
             "latency": spec.latency.to_json(),
-            "outcome": asdict(outcome),
+            "outcome": outcome_json(outcome, spec.tracker),
             "recording": spec.rrd,
             "wall_s": round(time.perf_counter() - t0, 3),
             "machine": asdict(machine()),
         }
+        if spec.tracker != ONE:  # only the people tracker's lines say it (OPTIONAL's rule)
+            row["tracker"] = spec.tracker
+        return row
     except Exception:  # noqa: BLE001 - reported per run
         return {"id": spec.id, "error": traceback.format_exc()}
 

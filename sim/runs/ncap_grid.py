@@ -17,6 +17,10 @@ the host is; on request a fixed figure or the host's measured latency per frame.
 row says which it applied (`latency`) and keeps the pipeline's measured latency of each
 frame (`outcome.latencies_ms`), so the report shows the host's latency beside the
 declared one and a run made with the measured latency can be replayed exactly.
+
+The tracker (`tracker`: one pedestrian or everyone, sim.runs.run_spec.TRACKERS) enters a
+run's id and line only when it is the people tracker, so a one-tracker grid keeps the ids
+and lines it always had (sim.runs.closed_loop.OPTIONAL for the outcome's fields).
 """
 
 from __future__ import annotations
@@ -30,8 +34,10 @@ from pathlib import Path
 from typing import Any
 
 from sim.runs.aeb import AebParams, run_aeb
+from sim.runs.closed_loop import outcome_json
 from sim.runs.latency import DECLARED, FIXED, MEASURED, LatencySetting
 from sim.runs.results_file import check_resumable, without_keys
+from sim.runs.run_spec import ONE, TRACKERS
 from sim.runs.runner import machine
 from sim.runs.sweep import SweepOutcome, rows_of, run_resumable
 from sim.scenario.files import ScenarioFile, load
@@ -86,8 +92,11 @@ class NcapRun:
     latency: LatencySetting = LatencySetting(MEASURED, None)
     replay: tuple[float, ...] | None = None
     rrd: str = ""
+    tracker: str = ONE  # whom the policy's pipeline follows (TRACKERS)
 
     def __post_init__(self) -> None:
+        if self.tracker not in TRACKERS:
+            raise ValueError(f"tracker must be one of {', '.join(TRACKERS)}, got {self.tracker!r}")
         if self.latency.ms != self.aeb.latency_ms:  # the row must say what the run applied
             raise ValueError(f"latency {self.latency} but AEB {self.aeb}")
 
@@ -96,9 +105,12 @@ def aeb_params(car: CarSpec, latency: LatencySetting) -> AebParams:
     return AebParams(car.brake_delay, car.jerk, car.deceleration, latency.ms)
 
 
-def run_digest(scenario: Scenario, aeb: AebParams) -> str:
-    """8 hex digits of the scenario and the AEB (brake and applied latency): a run's identity."""
+def run_digest(scenario: Scenario, aeb: AebParams, tracker: str = ONE) -> str:
+    """8 hex digits of the scenario, the AEB (brake and applied latency) and the tracker
+    (the people tracker only: a one-tracker run keeps its digest): a run's identity."""
     text = f"{scenario_digest(scenario)}|{aeb!r}"
+    if tracker != ONE:
+        text += f"|tracker={tracker}"
     return hashlib.sha1(text.encode()).hexdigest()[:8]
 
 
@@ -113,10 +125,12 @@ def expand(
     seeds: int | None = None,
     near_misses: bool = True,
     latency: LatencySetting | None = None,
+    tracker: str = ONE,
 ) -> list[NcapRun]:
     """Every run of the grid, in a stable order (policy, point, role, draw).
 
-    `latency` None: the car file's declared latency (sim.runs.ncap_grid.latency_setting).
+    `latency` None: the car file's declared latency (sim.runs.ncap_grid.latency_setting);
+    `tracker`: whom the pipelines follow (TRACKERS).
     """
     latency = latency_setting(car) if latency is None else latency
     n_grid = (car.quick_seeds if quick else car.seeds) if seeds is None else seeds
@@ -129,30 +143,30 @@ def expand(
             roles = [(GRID, k) for k in range(n_grid)]
             roles += [(VERIFY, n_grid + k) for k in range(car.verification_seeds)]
             for role, k in roles:
-                runs.append(grid_run(protocol, car, policy, point, role, k, latency))
+                runs.append(grid_run(protocol, car, policy, point, role, k, latency, tracker))
         for sf in files:
             for v in nm.quick_speeds_kmh if quick else nm.speeds_kmh:
                 if speeds is not None and v not in speeds:
                     continue
                 for k in range(nm.quick_seeds if quick else nm.seeds):
-                    runs.append(near_miss_run(protocol, car, policy, sf, v, k, latency))
+                    runs.append(near_miss_run(protocol, car, policy, sf, v, k, latency, tracker))
     return runs
 
 
 def grid_run(
     protocol: Protocol, car: CarSpec, policy: str, point: GridPoint, role: str, k: int,
-    latency: LatencySetting,
+    latency: LatencySetting, tracker: str = ONE,
 ) -> NcapRun:  # fmt: skip
     """The `k`-th draw of a grid point (role GRID or VERIFY)."""
     d = draw_for(protocol.tolerances, point.id, k)
     scenario = scenario_for(protocol, car, point, d, seed=k)
     meta = {**asdict(point), "draw": asdict(d), "load_case": protocol.tests[point.test].load_case}
-    return _run(protocol, car, policy, point.id, role, k, scenario, meta, latency)
+    return _run(protocol, car, policy, point.id, role, k, scenario, meta, latency, tracker)
 
 
 def near_miss_run(
     protocol: Protocol, car: CarSpec, policy: str, sf: ScenarioFile, speed_kmh: float, k: int,
-    latency: LatencySetting,
+    latency: LatencySetting, tracker: str = ONE,
 ) -> NcapRun:  # fmt: skip
     """Seed `k` of a car-scale near miss at `speed_kmh`, braking as the car does."""
     base = sf.scenario({"robot.speed": speed_kmh * KMH}, name=sf.name)
@@ -160,17 +174,22 @@ def near_miss_run(
     s = replace(base, robot=robot, seed=k)
     meta = {"test": "near-miss", "family": sf.name, "speed_kmh": speed_kmh}
     key = f"{sf.name}/{speed_kmh:g}kmh"
-    return _run(protocol, car, policy, key, NEAR_MISS, k, s, meta, latency)
+    return _run(protocol, car, policy, key, NEAR_MISS, k, s, meta, latency, tracker)
 
 
 def _run(protocol: Protocol, car: CarSpec, policy: str, key: str, role: str, k: int,
-         s: Scenario, meta: dict[str, Any], latency: LatencySetting) -> NcapRun:  # fmt: skip
+         s: Scenario, meta: dict[str, Any], latency: LatencySetting,
+         tracker: str = ONE) -> NcapRun:  # fmt: skip
     aeb = aeb_params(car, latency)
-    rid = f"{policy}/{key}/{role}{k}-{run_digest(s, aeb)}"
+    rid = f"{policy}/{key}/{role}{k}-{run_digest(s, aeb, tracker)}"
     # The files a rerun rebuilds the run from (sim.runs.rebuild), as the command was given them.
     meta = {**meta, "protocol": str(protocol.path), "car": str(car.path)}
     meta["lighting"] = s.scene.lighting.name
-    return NcapRun(rid, replace(s, name=rid), policy, aeb, role, k, meta, latency=latency)
+    if tracker != ONE:  # only the people tracker's lines say it (OPTIONAL's rule)
+        meta["tracker"] = tracker
+    return NcapRun(
+        rid, replace(s, name=rid), policy, aeb, role, k, meta, latency=latency, tracker=tracker
+    )
 
 
 def run_of(protocol: Protocol, car: CarSpec, row: dict[str, Any]) -> NcapRun:
@@ -179,18 +198,22 @@ def run_of(protocol: Protocol, car: CarSpec, row: dict[str, Any]) -> NcapRun:
     TypeError or ValueError for a row that is not a grid's line."""
     latency = LatencySetting.from_json(row["latency"])
     policy, role, k = row["policy"], row["role"], int(row["index"])
+    tracker = str(row.get("tracker", ONE))
+    if tracker not in TRACKERS:
+        raise ValueError(f"tracker {tracker!r}")
     if role == NEAR_MISS:
         for path in protocol.near_misses.files:
             sf = load(path)
             if sf.name == row["family"]:
-                return near_miss_run(protocol, car, policy, sf, float(row["speed_kmh"]), k, latency)
+                speed = float(row["speed_kmh"])
+                return near_miss_run(protocol, car, policy, sf, speed, k, latency, tracker)
         raise ValueError(f"{protocol.path}: no near miss {row['family']!r} in near_misses.files")
     if role not in (GRID, VERIFY):
         raise ValueError(f"role {role!r}")
     point = GridPoint(row["test"], row["function"], float(row["speed_kmh"]), float(row["impact"]))
     if point.test not in protocol.tests:
         raise ValueError(f"{protocol.path}: no test {point.test!r}")
-    return grid_run(protocol, car, policy, point, role, k, latency)
+    return grid_run(protocol, car, policy, point, role, k, latency, tracker)
 
 
 def work(spec: NcapRun, kept: KeptRenderContext | None = None) -> dict[str, Any]:
@@ -207,6 +230,7 @@ def work(spec: NcapRun, kept: KeptRenderContext | None = None) -> dict[str, Any]
             render_context=context,
             latencies_ms=spec.replay,
             rrd=Path(spec.rrd) if spec.rrd else None,
+            tracker=spec.tracker,
         )
         return {
             "schema": SCHEMA,
@@ -217,7 +241,7 @@ def work(spec: NcapRun, kept: KeptRenderContext | None = None) -> dict[str, Any]
             "index": spec.index,
             **spec.meta,
             "latency": spec.latency.to_json(),
-            "outcome": asdict(outcome),
+            "outcome": outcome_json(outcome, spec.tracker),
             "wall_s": round(time.perf_counter() - t0, 3),
             "machine": asdict(machine()),  # the CPU's model name, as a sweep's rows have it
         }

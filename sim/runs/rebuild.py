@@ -29,7 +29,7 @@ from typing import Any
 from monopic.errors import UserError
 from sim.runs.result import ABLATION, RunResult, values_said
 from sim.runs.results_file import read_rows
-from sim.runs.run_spec import ONE, RunSpec
+from sim.runs.run_spec import ONE, TRACKERS, RunSpec
 from sim.runs.sweep import PEOPLE_TAG, TREE_TAG, run_scenario, tree_digest
 from sim.scenario.files import ScenarioFile, load
 from sim.scenario.spec import Scenario
@@ -311,6 +311,9 @@ def rebuild_loop_line(line: dict[str, Any], asked: Asked) -> Any:
         source = grid.Source.from_json(line["source"])
         latency = LatencySetting.from_json(line["latency"])
         policy = str(line["policy"])
+        tracker = str(line.get("tracker", ONE))  # only the people tracker's lines say it
+        if tracker not in TRACKERS:
+            raise ValueError(f"tracker {tracker!r}")
         replay = replay_latencies(line)
     except (KeyError, TypeError, ValueError) as err:
         raise _not_a_line(line, asked, "a closed loop's", err) from None
@@ -320,7 +323,7 @@ def rebuild_loop_line(line: dict[str, Any], asked: Asked) -> Any:
     made = []
     for path in files:
         scenario = source.scenario(load(path) if path is not None else None)
-        made.append(grid.loop_run(scenario, policy, source, latency, str(asked.out)))
+        made.append(grid.loop_run(scenario, policy, source, latency, str(asked.out), tracker))
         if made[-1].id == line["id"]:
             break
     else:

@@ -293,8 +293,8 @@ def test_rerun_gives_a_closed_loop_runs_outcome_and_recording_with_its_latencies
     each frame: a row whose host measured 200 ms per frame (its brake acts 3 frames late)
     gives its outcome again on a host that measures far less."""
     import json
-    from dataclasses import asdict
 
+    from sim.runs.closed_loop import outcome_json
     from sim.runs.closed_loop_grid import Source
     from tests.rrd import rows_per_entity
 
@@ -319,7 +319,7 @@ def test_rerun_gives_a_closed_loop_runs_outcome_and_recording_with_its_latencies
     scenario = Source(file=str(path)).scenario()
     slow = run_closed_loop(scenario, "rules/ground", seed=scenario.seed, latency_ms=200.0)
     assert slow.braked and set(slow.delays) == {3}
-    line = json.loads(json.dumps({**braking, "outcome": asdict(slow)}))
+    line = json.loads(json.dumps({**braking, "outcome": outcome_json(slow, "one")}))
     line["outcome"]["latencies_ms"] = [200.0] * len(slow.latencies_ms)
     measured = tmp_path / "measured.jsonl"
     measured.write_text(json.dumps(line) + "\n")
