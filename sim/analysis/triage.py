@@ -339,7 +339,7 @@ def loop_triage_lines(
     """The closed loop's runs to look at (sim.runs.closed_loop.went_wrong: a braking
     policy's contacts and needless stops), per policy, each with its scenario, recording
     (`recorded`: the command kept recordings) and rerun command."""
-    from sim.runs.closed_loop import CONTACT, WENT_WRONG, went_wrong
+    from sim.runs.closed_loop import CONTACT, WENT_WRONG, WRONG_PERSON, went_wrong
     from sim.runs.closed_loop_grid import outcome_of, source_said
 
     outcomes = [outcome_of(row) for row in rows]
@@ -367,6 +367,8 @@ def loop_triage_lines(
     for row, o, what in wrong:
         how_ = (f"contact at {o.impact_speed:.2f} m/s" if what == CONTACT and o.impact_speed
                 is not None else what)  # fmt: skip
+        if what == WRONG_PERSON:
+            how_ = o.braked_for_said() or what
         if what != CONTACT and o.brake_time is not None:
             how_ += f" (brake from {o.brake_time:.2f} s)"
         recording = None
@@ -393,14 +395,18 @@ def ncap_triage_lines(rows: Sequence[dict[str, Any]], where: Rerunning) -> list[
     """The Euro NCAP grid's runs to look at: every run that hit the target (contact) and
     every near miss the car braked on (braked without need), per policy and test, each
     with its grid point and rerun command."""
-    from sim.runs.closed_loop import CONTACT, NEEDLESS, WENT_WRONG
+    from sim.runs.closed_loop import CONTACT, NEEDLESS, WENT_WRONG, WRONG_PERSON
     from sim.runs.ncap_grid import NEAR_MISS, run_said
+    from sim.world.warned_for import NOBODY
 
     wrong = []
     for row in rows:
         o = row["outcome"]
+        named = o.get("braked_for")
         if o["contact"]:
             wrong.append((row, CONTACT, -(o["relative_impact_speed"] or 0.0)))
+        elif named is not None and (named == NOBODY or o.get("braked_for_on_course") is False):
+            wrong.append((row, WRONG_PERSON, o["brake_time"] or 0.0))
         elif row["role"] == NEAR_MISS and o["brake_time"] is not None:
             wrong.append((row, NEEDLESS, o["brake_time"]))
     wrong.sort(key=lambda w: (WENT_WRONG.index(w[1]), w[2]))
@@ -425,6 +431,12 @@ def ncap_triage_lines(rows: Sequence[dict[str, Any]], where: Rerunning) -> list[
             rel = o["relative_impact_speed"]
             said = f"contact at {3.6 * o['impact_speed']:.1f} km/h" if o["impact_speed"] else what
             said += f" ({3.6 * rel:.1f} km/h relative)" if rel is not None else ""
+        elif what == WRONG_PERSON:
+            track = o.get("braked_for_track")
+            whom = o["braked_for"] if o["braked_for"] != NOBODY else "nobody (a phantom)"
+            said = f"braked for {whom}" + (f" (track {track})" if track is not None else "")
+            said += ", not on a collision course" if o["braked_for"] != NOBODY else ""
+            said += f" (brake from {o['brake_time']:.2f} s)"
         else:
             said = f"{what} (brake from {o['brake_time']:.2f} s)"
         listed.append(

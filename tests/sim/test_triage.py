@@ -345,3 +345,22 @@ def test_the_ncap_report_lists_contacts_and_braked_near_misses_with_a_rerun_comm
     assert (
         "  `monopic rerun recordings/ncap/results.jsonl rules/ground/cpna/grid0-0123abcd`" in text
     )
+
+
+def test_the_ncap_report_lists_braking_for_the_wrong_person_naming_them() -> None:
+    from sim.analysis.triage import Rerunning, ncap_triage_lines
+
+    wrong = _ncap_row("grid", 3, False, True)
+    wrong["outcome"].update(braked_for="bystander", braked_for_track=2, braked_for_on_course=False)
+    phantom = _ncap_row("grid", 4, False, True)
+    phantom["outcome"].update(braked_for="nobody", braked_for_track=5)
+    right = _ncap_row("grid", 5, False, True)
+    right["outcome"].update(braked_for="ped", braked_for_track=1, braked_for_on_course=True)
+    out = Path("recordings/ncap")
+    text = "\n".join(
+        ncap_triage_lines([wrong, phantom, right], Rerunning(out / "r.jsonl", out, out))
+    )
+    listed = [ln.split("`")[1] for ln in text.splitlines() if ln.startswith("- `")]
+    assert listed == ["rules/ground/cpna/grid3-0123abcd", "rules/ground/cpna/grid4-0123abcd"]
+    assert "**braked for bystander (track 2), not on a collision course (brake from 1.50 s)**" in text
+    assert "**braked for nobody (a phantom) (track 5) (brake from 1.50 s)**" in text
