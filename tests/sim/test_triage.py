@@ -362,5 +362,6 @@ def test_the_ncap_report_lists_braking_for_the_wrong_person_naming_them() -> Non
     )
     listed = [ln.split("`")[1] for ln in text.splitlines() if ln.startswith("- `")]
     assert listed == ["rules/ground/cpna/grid3-0123abcd", "rules/ground/cpna/grid4-0123abcd"]
-    assert "**braked for bystander (track 2), not on a collision course (brake from 1.50 s)**" in text
+    said = "braked for bystander (track 2), not on a collision course (brake from 1.50 s)"
+    assert f"**{said}**" in text
     assert "**braked for nobody (a phantom) (track 5) (brake from 1.50 s)**" in text
