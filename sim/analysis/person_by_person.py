@@ -58,9 +58,12 @@ class RunVerdict:
     missed: tuple[int, ...]  # of those, never warned for on course before their contact
     warned_frames: int
     for_threat_frames: int
-    wrong_person_frames: int
+    wrong_person_frames: int  # for someone not on course then and never after
     phantom_frames: int
     wrong_people: tuple[int, ...]  # people warned for while not on course, in order
+    # For a person who is on course later, before their course starts (the horizon does
+    # not reach their contact yet): an early warning for the threat, not the wrong person.
+    early_frames: int = 0
 
     @property
     def warned_1s_for_threat(self) -> bool:
@@ -111,15 +114,18 @@ def judge_run(row: RunResult, method: str) -> RunVerdict | None:
     threats = tuple(i for i, course in enumerate(on_course) if any(course))
     contacts = {i: earliest_contact(times, _padded(people[i].ttc, len(times))) for i in threats}
     first = _first_threat(row, on_course)
-    for_threat = wrong = phantom = 0
+    for_threat = early = wrong = phantom = 0
     wrong_people: list[int] = []
     warned_on_course: dict[int, list[int]] = {i: [] for i in threats}
+    course_from = {i: on_course[i].index(True) for i in threats}
     for w in warned:
         if w.person is None:
             phantom += 1
         elif on_course[w.person][w.k]:
             for_threat += 1
             warned_on_course[w.person].append(w.k)
+        elif w.person in course_from and w.k < course_from[w.person]:
+            early += 1  # for the threat before the horizon reaches their contact
         else:
             wrong += 1
             if w.person not in wrong_people:
@@ -142,6 +148,7 @@ def judge_run(row: RunResult, method: str) -> RunVerdict | None:
         missed=missed,
         warned_frames=len(warned),
         for_threat_frames=for_threat,
+        early_frames=early,
         wrong_person_frames=wrong,
         phantom_frames=phantom,
         wrong_people=tuple(wrong_people),
@@ -176,6 +183,7 @@ class PersonByPersonSummary:
     phantom: int
     runs_wrong_person: int  # runs with a wrong-person warning frame
     runs_phantom: int  # runs with a phantom warning frame
+    early: int = 0  # warned frames for a threat before their course starts
 
     @property
     def recall_1s(self) -> float:
@@ -194,6 +202,7 @@ def summarise(verdicts: Sequence[RunVerdict]) -> PersonByPersonSummary:
         near_misses_warned=sum(v.near_miss and v.warned_frames > 0 for v in verdicts),
         warned_frames=sum(v.warned_frames for v in verdicts),
         for_threat=sum(v.for_threat_frames for v in verdicts),
+        early=sum(v.early_frames for v in verdicts),
         wrong_person=sum(v.wrong_person_frames for v in verdicts),
         phantom=sum(v.phantom_frames for v in verdicts),
         runs_wrong_person=sum(v.wrong_person_frames > 0 for v in verdicts),

@@ -32,13 +32,13 @@ def person_by_person_lines(rows: Sequence[RunResult], methods: Sequence[str]) ->
             if not verdicts:
                 continue
             s = summarise(verdicts)
-            said = s.for_threat + s.wrong_person + s.phantom
+            said = s.for_threat + s.early + s.wrong_person + s.phantom
             body.append([
                 family, method, str(s.runs),
                 f"{s.warned_1s}/{s.threat_runs}" if s.threat_runs else "-",
                 f"{s.missed_people}/{s.threat_people}" if s.threat_people else "-",
                 f"{s.near_misses_warned}/{s.near_misses}" if s.near_misses else "-",
-                f"{s.for_threat} / {s.wrong_person} / {s.phantom}" if said else "-",
+                f"{s.for_threat} / {s.early} / {s.wrong_person} / {s.phantom}" if said else "-",
                 str(s.runs_wrong_person), str(s.runs_phantom),
             ])  # fmt: skip
     return [
@@ -54,7 +54,8 @@ def person_by_person_lines(rows: Sequence[RunResult], methods: Sequence[str]) ->
         "contact.",
         "Missed people: people ever on a collision course never warned for while on course",
         "before their contact (people, not runs). Warned frames: for a person on course / for",
-        "a person not on course that frame (the wrong person) / for nobody.",
+        "a person on course later, before their course starts (early) / for a person on course",
+        "neither then nor later (the wrong person) / for nobody.",
         "",
         *table(
             [
@@ -64,7 +65,7 @@ def person_by_person_lines(rows: Sequence[RunResult], methods: Sequence[str]) ->
                 f"warned {LEAD_GOAL:g} s ahead for the threat",
                 "missed people",
                 "near misses warned",
-                "warned frames: threat / wrong / phantom",
+                "warned frames: threat / early / wrong / phantom",
                 "runs with a wrong-person warning",
                 "runs with a phantom",
             ],

@@ -74,14 +74,15 @@ def test_a_warning_only_for_the_bystander_is_for_the_wrong_person_and_misses_the
     assert v.missed == (0,)
 
 
-def test_a_track_on_nobody_is_a_phantom_and_a_warning_before_the_course_is_wrong() -> None:
-    # Frames 3-4: for the child before they are on course (wrong person); 8-9 a phantom;
-    # from 11 (1.1 s) for the child on course: 1.1 s before contact.
+def test_a_track_on_nobody_is_a_phantom_and_a_warning_before_the_course_is_early() -> None:
+    # Frames 3-4: for the child before they are on course (early); 8-9 a phantom; from
+    # 11 (1.1 s) for the child on course: 1.1 s before contact.
     row = line({3: CHILD, 4: CHILD, 8: GHOST, 9: GHOST, **frames(CHILD, range(11, N))})
     v = judge_run(row, "rules/image")
     assert v is not None
-    assert (v.for_threat_frames, v.wrong_person_frames, v.phantom_frames) == (11, 2, 2)
-    assert v.wrong_people == (0,) and v.lead == pytest.approx(1.1) and v.warned_1s_for_threat
+    assert (v.for_threat_frames, v.early_frames, v.wrong_person_frames) == (11, 2, 0)
+    assert v.phantom_frames == 2 and v.wrong_people == ()
+    assert v.lead == pytest.approx(1.1) and v.warned_1s_for_threat
     late = judge_run(line(frames(CHILD, range(15, N))), "rules/image")
     assert late is not None and late.lead == pytest.approx(0.7) and not late.warned_1s_for_threat
     assert late.missed == ()  # warned, though late
@@ -157,7 +158,7 @@ def test_the_report_judges_people_tracker_lines_person_by_person(tmp_path: Path)
     assert lines[0] == "## Several people: person by person"
     judged, tracked = ([c.strip() for c in x.strip("|").split("|")]
                        for x in lines if x.startswith("| fam "))  # fmt: skip
-    assert judged == ["fam", "rules/image", "3", "2/3", "1/3", "-", "24 / 12 / 2", "1", "1"]
+    assert judged == ["fam", "rules/image", "3", "2/3", "1/3", "-", "24 / 0 / 12 / 2", "1", "1"]
     # Every frame the ghost track is a false positive beside two perfect tracks: MOTA
     # 1 - 22/44 per run, IDF1 2 * 44 / (44 + 66).
     assert tracked == ["fam", "3", "132", "50 %", "80 %", "0.00 (0)", "100 %", "67 %"]
@@ -186,7 +187,8 @@ def test_a_real_people_tracker_run_is_judged_and_scored(tmp_path: Path) -> None:
     for key, v in verdicts.items():
         warned = sum(w is not None for w in row.tracks["main"].warned_for[key])
         assert v.warned_frames == warned
-        assert v.for_threat_frames + v.wrong_person_frames + v.phantom_frames == warned
+        said = v.for_threat_frames + v.early_frames + v.wrong_person_frames + v.phantom_frames
+        assert said == warned
         assert v.threatened and v.first_threat == child  # the child steps out
     # Somebody's warning is for the child on course: the pairing finds them.
     assert any(v.for_threat_frames for v in verdicts.values())
