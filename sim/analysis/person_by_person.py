@@ -108,6 +108,13 @@ def judge_run(row: RunResult, method: str) -> RunVerdict | None:
     warned = warned_frames(row, method)
     if warned is None:
         return None
+    return judge_warned(row, method, warned)
+
+
+def judge_warned(row: RunResult, method: str, warned: Sequence[WarnedFrame]) -> RunVerdict:
+    """The verdict on a line's warned frames, however they were attributed (the people
+    tracker's by its tracks; a one-pedestrian line's can be by its foot point,
+    sim.analysis.people.warned_people, for a before-and-after on the same rules)."""
     times = row.truth.t
     people = row.people
     on_course = [[bool(_at(p.collision, k)) for k in range(len(times))] for p in people]
