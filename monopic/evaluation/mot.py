@@ -390,20 +390,9 @@ def score_tracks(
     return TrackScores(
         frames=frames,
         min_iou=min_iou,
-        mota=float(m["mota"]),
-        # motmetrics' MOTP is the mean distance (1 - IoU) of the matches.
-        motp=1.0 - float(m["motp"]),
-        idf1=float(m["idf1"]),
+        **_clear_scores(m),
         idp=float(m["idp"]),
         idr=float(m["idr"]),
-        recall=float(m["recall"]),
-        precision=float(m["precision"]),
-        switches=int(m["num_switches"]),
-        fragmentations=int(m["num_fragmentations"]),
-        false_positives=int(m["num_false_positives"]),
-        misses=int(m["num_misses"]),
-        matches=int(m["num_detections"]),
-        gt_boxes=int(m["num_objects"]),
         track_boxes=seq.track_boxes,
         distractor_boxes=seq.distractor_boxes,
         false_positives_on_unscored=_false_positives_on_unscored(
@@ -469,19 +458,27 @@ def score_sequences(sequences: Sequence[MotSequence], min_iou: float = 0.5) -> P
     return PooledScores(
         sequences=len(sequences),
         min_iou=min_iou,
-        mota=float(m["mota"]),
-        motp=1.0 - float(m["motp"]),
-        idf1=float(m["idf1"]),
-        recall=float(m["recall"]),
-        precision=float(m["precision"]),
-        switches=int(m["num_switches"]),
-        fragmentations=int(m["num_fragmentations"]),
-        false_positives=int(m["num_false_positives"]),
-        misses=int(m["num_misses"]),
-        matches=int(m["num_detections"]),
-        gt_boxes=int(m["num_objects"]),
+        **_clear_scores(m),
         gt_identities=int(m["num_unique_objects"]),
     )
+
+
+def _clear_scores(m) -> dict[str, float | int]:
+    """The CLEAR MOT and identity figures one sequence and a pool of them both report."""
+    return {
+        "mota": float(m["mota"]),
+        # motmetrics' MOTP is the mean distance (1 - IoU) of the matches.
+        "motp": 1.0 - float(m["motp"]),
+        "idf1": float(m["idf1"]),
+        "recall": float(m["recall"]),
+        "precision": float(m["precision"]),
+        "switches": int(m["num_switches"]),
+        "fragmentations": int(m["num_fragmentations"]),
+        "false_positives": int(m["num_false_positives"]),
+        "misses": int(m["num_misses"]),
+        "matches": int(m["num_detections"]),
+        "gt_boxes": int(m["num_objects"]),
+    }
 
 
 def _false_positives_on_unscored(

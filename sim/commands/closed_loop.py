@@ -22,6 +22,7 @@ from sim.commands.executor_options import (
     logs_above_the_bar,
     make_executor,
 )
+from sim.commands.tracker_option import add_tracker_option
 
 if TYPE_CHECKING:  # the simulator is imported when the command runs
     from sim.scenario.spec import Scenario
@@ -33,13 +34,6 @@ DEFAULT_POLICIES = "none,truth,rules/image,rules/ground"
 MEET_TIME = 3.0  # s: --cases crossings meet the robot then unless it brakes
 CASE_SPEEDS = "1,2,3"  # m/s: --cases has no file to take a speed from
 DEFAULT_RESULTS = Path("recordings/closed-loop.jsonl")
-TRACKERS = ("one", "everyone")  # sim.runs.run_spec.TRACKERS (imported when the command runs)
-TRACKER_HELP = (
-    "whom the policy's pipeline follows: 'one' pedestrian (the one-pedestrian tracker, the "
-    "default: every earlier figure is made with it) or 'everyone' in view (the people "
-    "tracker: the brake acts on the worst person's warning); each run names whom the car "
-    "braked for"
-)
 
 
 def register(sub: argparse._SubParsersAction) -> None:
@@ -109,7 +103,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="results file, one line per finished run, resumable (default: beside --out "
         f"as <out>.jsonl; without --out {DEFAULT_RESULTS})",
     )
-    p.add_argument("--tracker", choices=TRACKERS, default="one", help=TRACKER_HELP)
+    add_tracker_option(p, "figure")
     p.add_argument("--rrd-dir", type=Path, help="record every braking run into this folder")
     add_executor_options(p)
     p.add_argument(

@@ -16,12 +16,12 @@ from sim.commands.executor_options import (
     logs_above_the_bar,
     make_executor,
 )
+from sim.commands.tracker_option import add_tracker_option
 
 PROTOCOL = Path("scenarios/ncap/protocol.toml")
 CAR = Path("scenarios/ncap/car.toml")
 # The protocol's day tests this grid runs, by their protocol.toml names (a test checks).
 TESTS = ("cpna", "cpfa", "cpnco", "cpla")
-TRACKERS = ("one", "everyone")  # sim.runs.run_spec.TRACKERS (imported when the command runs)
 LEFT_UNSCORED = (
     "CPNA, CPFA, CPNCO and CPLA at night (their night matrices are filled Red: not run, "
     "no claim); CPTA (turning: needs a robot that turns and a truth that follows it); the "
@@ -84,15 +84,7 @@ def register(sub: argparse._SubParsersAction) -> None:
         help="apply the pipeline's latency measured on this host per frame instead of the "
         "declared one (the score then moves with the host's speed and load)",
     )
-    p.add_argument(
-        "--tracker",
-        choices=TRACKERS,
-        default="one",
-        help="whom the policy's pipeline follows: 'one' pedestrian (the one-pedestrian "
-        "tracker, the default: every earlier rating is made with it) or 'everyone' in view "
-        "(the people tracker: the car brakes on the worst person's warning); each run names "
-        "whom the car braked for",
-    )
+    add_tracker_option(p, "rating")
     add_executor_options(p)
     p.add_argument("--restart", action="store_true", help="set aside other code's results")
     p.add_argument(
