@@ -94,3 +94,22 @@ def test_the_crowd_table_gives_the_model_beside_the_rendered_frame() -> None:
     results, table = simulator.crowd_report(got, 60)
     assert results["crowd"]["5"]["world_step_p50_ms"] == 100.0
     assert "| 5 | 0.50 ms | 1.00 ms | 0.050 ms | 100 ms | 0.010 |" in table
+
+
+def test_the_people_runs_report_gives_each_count_and_tracker_against_one_person() -> None:
+    from bench.simulator import people_runs_report
+
+    got = {
+        "rounds": 2,
+        "maxrss_mb": 900.0,
+        "1/one": {"wall_s": [10.0, 12.0], "frames": 40},
+        "1/everyone": {"wall_s": [14.0, 14.0], "frames": 40},
+        "5/one": {"wall_s": [20.0, 22.0], "frames": 40},
+        "5/everyone": {"wall_s": [40.0, 44.0], "frames": 40},
+    }
+    results, table = people_runs_report(got, 40)
+    rows = {(r["people"], r["tracker"]): r for r in results["rows"]}
+    assert rows[(1, "one")]["frame_ms"] == pytest.approx(275.0)  # median 11 s / 40 frames
+    assert rows[(5, "everyone")]["vs_one_person_x"] == pytest.approx(42 / 14)
+    assert rows[(5, "everyone")]["vs_one_tracker_x"] == pytest.approx(42 / 21)
+    assert "| 5 | everyone | 42.0 | 1050.0 | 3.00x | 2.00x |" in table
