@@ -166,12 +166,15 @@ def test_dry_run_shows_runs_per_family_and_a_time_it_says_how_it_computed(
     assert lines[4] == (
         f"time: about 11 s on 2 workers: 8 s to start, then up to 66 frames x {bench:.3f} s "
         "per frame and worker "
-        "(the simulator benchmark's 79.5/101.2 ms per 768x432 frame (bench/history.jsonl); "
-        "no run measured yet)"
+        "(the simulator benchmark's 79.5/101.2 ms per 768x432 frame and its per-person "
+        "figures (bench/history.jsonl); no run measured yet)"
     )
     assert not out.exists()  # a dry run writes nothing
-    # Finished runs in the results file replace the benchmark's figure by their own.
+    # Finished runs in the results file scale each run's benchmark figure by how much
+    # slower they ran than theirs (lines without a camera: the default 768x432, one person).
+    from sim.runs.estimate import bench_frame_seconds
     from sim.runs.sweep import load_spec, sweep_code
+    from sim.scenario.spec import CameraSpec
 
     mine = {"sweep": "t", "code": sweep_code(load_spec(spec))}  # else the run would refuse it
     rows = [{"id": "x/1", "frames": 10, "timing": {"wall_s": 3.0}, **mine},
@@ -179,8 +182,13 @@ def test_dry_run_shows_runs_per_family_and_a_time_it_says_how_it_computed(
     out.write_text("".join(json.dumps(r) + "\n" for r in rows))
     assert main(["sweep", str(spec), "--out", str(out), "--dry-run", "--no-ablation"]) == 0
     time_line = capsys.readouterr().out.splitlines()[4]
+    full, small = CameraSpec(), CameraSpec(width=256, height=144)
+    scale = 8.0 / (40 * bench_frame_seconds(full, False))
+    per = scale * (6 * bench_frame_seconds(small, False) + 60 * bench_frame_seconds(full, False))
     assert time_line.startswith("time: about ") and time_line.endswith(
-        f"up to 66 frames x 0.200 s per frame and worker (measured on 2 finished runs in {out})"
+        f"up to 66 frames x {per / 66:.3f} s per frame and worker (each run's benchmark "
+        f"figure for its camera and people x {scale:.2f}, as measured on 2 finished runs in "
+        f"{out})"
     )
 
 
