@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
+from sim.runs.run_spec import ONE
 from sim.runs.sweep import SweepSpec, expand_spec
 from sim.runs.sweep import parse_spec as parse_sweep_spec
 from sim.scenario.files import PEOPLE_KEY, people_files
@@ -63,6 +64,12 @@ def load_spec(path: Path) -> DatasetSpec:
             f"other placement keys of scenarios/datasets/case_grid.toml instead (see {DOC})",
         )  # fmt: skip
     sweep = parse_sweep_spec(path, data, DOC, "dataset spec")
+    if sweep.tracker != ONE:  # the features CSV is the one-pedestrian pipeline's
+        raise FieldError(
+            path, "tracker", sweep.tracker,
+            "a dataset's features/<run>.csv is the one-pedestrian pipeline's log; run the "
+            "people tracker on a dataset's frames with `monopic video mot/<run> --tracks`",
+        )  # fmt: skip
     licence = sweep.licence or DEFAULT_LICENCE
     files = _scenario_files(sweep)
     return DatasetSpec(path, sweep.name, sweep.description, licence, sweep, text, files)

@@ -92,6 +92,20 @@ def test_the_old_grid_form_is_refused_with_the_way_to_write_it(tmp_path):
     assert "case_grid.toml" in message and "\n" not in message
 
 
+def test_a_dataset_refuses_the_people_tracker_in_one_line(tmp_path):
+    text = TINY.replace(
+        'description = "two short runs for the tests"\n',
+        'description = "two short runs for the tests"\ntracker = "everyone"\n',
+    )
+    path = write_spec(tmp_path, text)
+    with pytest.raises(UserError) as err:
+        load_spec(path)
+    message = str(err.value)
+    assert message.startswith(f"{path}: tracker = ") and "monopic video" in message
+    assert "\n" not in message
+    assert load_spec(write_spec(tmp_path, text.replace("everyone", "one"))).source.tracker == "one"
+
+
 def test_a_case_grid_expands_in_a_fixed_order_with_distinct_seeds_and_no_repeats(tmp_path):
     text = TINY.replace('"path.case" = [5, 6]', '"path.case" = [5, 6, 9]')
     text = text.replace(
