@@ -397,7 +397,7 @@ def ncap_triage_lines(rows: Sequence[dict[str, Any]], where: Rerunning) -> list[
     with its grid point and rerun command."""
     from sim.runs.closed_loop import CONTACT, NEEDLESS, WENT_WRONG, WRONG_PERSON
     from sim.runs.ncap_grid import NEAR_MISS, run_said
-    from sim.world.warned_for import NOBODY
+    from sim.world.warned_for import NOBODY, braked_wrong
 
     wrong = []
     for row in rows:
@@ -405,7 +405,7 @@ def ncap_triage_lines(rows: Sequence[dict[str, Any]], where: Rerunning) -> list[
         named = o.get("braked_for")
         if o["contact"]:
             wrong.append((row, CONTACT, -(o["relative_impact_speed"] or 0.0)))
-        elif named is not None and (named == NOBODY or o.get("braked_for_on_course") is False):
+        elif braked_wrong(named, o.get("braked_for_on_course")):
             wrong.append((row, WRONG_PERSON, o["brake_time"] or 0.0))
         elif row["role"] == NEAR_MISS and o["brake_time"] is not None:
             wrong.append((row, NEEDLESS, o["brake_time"]))

@@ -39,7 +39,6 @@ import numpy as np
 
 from sim.recording.sim_recording import SimRecording
 from sim.runs.closed_loop import (
-    NOBODY,
     POLICY,
     LoopLog,
     braked_for_fields,
@@ -53,7 +52,7 @@ from sim.runs.run_spec import ONE
 from sim.scenario.spec import Scenario
 from sim.world.ground_truth import pedestrian_passed
 from sim.world.render import RenderContext
-from sim.world.warned_for import WarnedFor
+from sim.world.warned_for import WarnedFor, braked_wrong
 from sim.world.world import World, WorldStep
 
 
@@ -205,9 +204,7 @@ class AebOutcome:
     @property
     def wrong_person(self) -> bool:
         """Braked for nobody or for someone not on a collision course."""
-        return self.braked_for is not None and (
-            self.braked_for == NOBODY or self.braked_for_on_course is False
-        )
+        return braked_wrong(self.braked_for, self.braked_for_on_course)
 
 
 def run_aeb(

@@ -56,7 +56,12 @@ from sim.runs.run_spec import ONE
 from sim.scenario.spec import Scenario
 from sim.world.ground_truth import footprint_gap, pedestrian_passed
 from sim.world.render import RenderContext
-from sim.world.warned_for import NOBODY, WarnedFor, oracle_warned_for, warned_for
+from sim.world.warned_for import (
+    WarnedFor,
+    braked_wrong,
+    oracle_warned_for,
+    warned_for,
+)
 from sim.world.world import World, WorldStep
 
 NO_BRAKE = "none"
@@ -100,9 +105,7 @@ class LoopOutcome:
     def wrong_person(self) -> bool:
         """Braked for nobody or for someone not on a collision course (known only where
         the run names whom it braked for)."""
-        return self.braked_for is not None and (
-            self.braked_for == NOBODY or self.braked_for_on_course is False
-        )
+        return braked_wrong(self.braked_for, self.braked_for_on_course)
 
     def braked_for_said(self) -> str | None:
         """'braked for adult (track 3, not on a collision course)', None if unnamed."""

@@ -62,6 +62,12 @@ class WarnedFor:
         return f"{self.name} ({track}{course})"
 
 
+def braked_wrong(name: str | None, on_course: bool | None) -> bool:
+    """A brake named for nobody or for someone not on a collision course, as a run's
+    outcome stores it (False when the run names no one: an older line, no brake)."""
+    return name is not None and (name == NOBODY or on_course is False)
+
+
 def warned_for(result: FrameResult, truth: GroundTruth) -> WarnedFor | None:
     """The person the robot warning of `result` was for (None when it names no track).
 
