@@ -9,6 +9,10 @@ whose lights are entities (sim.world.entities); nothing else needs to change.
 `name` is the preset the lighting came from; results record it (sim.runs.result) and a
 report can group by it. A file that moves the sun (`sun_azimuth_deg`, `sun_elevation_deg`)
 keeps its preset's name and records the angles it used in the scenario.
+
+Illuminance (for a real camera's sensor, sim.sensor): a clear sky's 32,000 lux is the low
+end of direct sunlight and an overcast sky's 1,000 lux the usual figure for an overcast day
+(the illuminance tables of the lux's definition, e.g. Wikipedia's "Lux").
 """
 
 from __future__ import annotations
@@ -39,6 +43,9 @@ class Lighting:
     sun: Sun
     sky_ambient: RGB = (0.32, 0.32, 0.33)
     sky_diffuse: RGB = (0.25, 0.25, 0.25)
+    # What the render's white stands for: the illuminance on a white surface drawn at full
+    # brightness (sim.sensor.photometry). Only a real camera's sensor reads it.
+    illuminance_lux: float = 32000.0
 
     @property
     def shadows(self) -> bool:
@@ -61,7 +68,10 @@ def overcast(name: str, azimuth_deg: float, elevation_deg: float) -> Lighting:
     It also halves the render time on software GL: the shadow pass is half of it
     (bench/simulator.py)."""
     sun = Sun(azimuth_deg, elevation_deg, shadows=False, diffuse=(0.35, 0.35, 0.36))
-    return Lighting(name, sun, sky_ambient=(0.5, 0.5, 0.52), sky_diffuse=(0.3, 0.3, 0.3))
+    return Lighting(
+        name, sun, sky_ambient=(0.5, 0.5, 0.52), sky_diffuse=(0.3, 0.3, 0.3),
+        illuminance_lux=1000.0,
+    )  # fmt: skip
 
 
 # The robot drives east, so azimuth 0 is a low sun straight ahead (backlit pedestrians).

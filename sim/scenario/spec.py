@@ -19,6 +19,7 @@ from sim.scenario import presets
 from sim.scenario.lighting import DAY, PRESETS, Lighting
 from sim.scenario.plan import Anchor, Leg
 from sim.scenario.walkers import HumanWalker, RailWalker, Walker
+from sim.sensor.spec import IDEAL, SensorSpec
 
 RGB = tuple[float, float, float]
 
@@ -126,6 +127,13 @@ class CameraSpec:
     mount_height: float = presets.CAMERA_MOUNT_HEIGHT  # m above the ground
     pitch_deg: float = presets.CAMERA_PITCH_DEG  # positive looks down
     mount_forward: float = 0.0  # m ahead of the robot's reference point
+    # The image sensor behind the lens (sim.sensor): None is the `ideal` camera, the
+    # renderer's frames as they are; a preset's figures otherwise.
+    sensor: SensorSpec | None = None
+
+    @property
+    def sensor_name(self) -> str:
+        return IDEAL if self.sensor is None else self.sensor.name
 
     def model(self) -> CameraModel:
         return CameraModel.from_fov(
@@ -298,6 +306,9 @@ class Scenario:
             value = getattr(self, name)
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"scenario {self.name!r}: {name} must be positive, got {value}")
+        sensor = self.robot.camera.sensor
+        if sensor is not None:
+            sensor.check_frame_rate(self.dt)
         names = [person_name(p, k) for k, p in enumerate(self.people)]
         if len(set(names)) != len(names):
             raise ValueError(f"scenario {self.name!r}: two people share a name in {names}")
@@ -333,6 +344,7 @@ def scenario_text(s: Scenario) -> str:
     and the scene as its own (scene_identity): any change of the scenario is another run,
     and a new layout of the records is not."""
     written: dict[str, object] = {
+        "robot": _Written(robot_identity(s.robot)),
         "pedestrian": _Written(person_identity(s.pedestrian)),
         "bystanders": tuple(_Written(person_identity(p)) for p in s.bystanders),
         "scene": _Written(scene_identity(s.scene)),
@@ -350,6 +362,15 @@ def person_identity(person: PedestrianSpec) -> str:
     name (added since) only when it is set."""
     text = repr(replace(person, behaviour=_Written(person.behaviour.identity())))
     return text.removesuffix(", name='')") + ")" if not person.name else text
+
+
+def robot_identity(robot: RobotSpec) -> str:
+    """The robot as identities have always written it: its camera's sensor (added since)
+    only when it is a real one, so an ideal camera's runs keep their ids."""
+    camera = repr(robot.camera)
+    if robot.camera.sensor is None:
+        camera = camera.removesuffix(", sensor=None)") + ")"
+    return repr(replace(robot, camera=_Written(camera)))
 
 
 def scene_identity(scene: SceneSpec) -> str:

@@ -44,6 +44,7 @@ from monopic.camera import CameraModel
 from monopic.cases import Case, case_from_ground_velocity
 from sim.geometry.frames import Pose2D, wrap_angle
 from sim.geometry.polygons import polygon_gap, rectangle
+from sim.sensor.exposure import ExposureState
 from sim.world.body import PedestrianTruth
 from sim.world.intent import Intent
 from sim.world.pedestrian import Pedestrian
@@ -325,6 +326,8 @@ class GroundTruth:
     people: tuple[PersonTruth, ...]  # the scenario's pedestrian first
     # The other bodies' truth by entity name (a parked car, a test's toy); None: nothing.
     bodies: Mapping[str, object] = field(default_factory=dict)
+    # A real camera's exposure of this frame (sim.sensor); None: the ideal camera.
+    camera: ExposureState | None = None
 
     @property
     def pedestrian(self) -> PersonTruth:
@@ -343,6 +346,8 @@ class GroundTruth:
         }
         if len(self.people) > 1:
             out["people"] = [p.to_dict(full=True) for p in self.people]
+        if self.camera is not None:
+            out["camera"] = self.camera.to_dict()
         return out
 
 

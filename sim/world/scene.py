@@ -17,6 +17,7 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import mujoco
 import numpy as np
@@ -115,6 +116,49 @@ def build_spec(config: SceneConfig, entities: Sequence[Entity]) -> mujoco.MjSpec
     return spec
 
 
+@dataclass(frozen=True)
+class SceneState:
+    """Where every placed body was at one moment: MuJoCo's joint positions and mocap poses
+    (copies), enough to put the scene back there or part of the way to another moment."""
+
+    qpos: np.ndarray
+    mocap_pos: np.ndarray
+    mocap_quat: np.ndarray
+
+
+PROBE_COLUMNS = 5  # ground probes across the image ...
+PROBE_ROWS = 3  # ... in its lower rows, where the nearest ground is
+
+
+def _pixels(
+    cam: CameraModel, position: np.ndarray, rotation: np.ndarray, points: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """World points through a MuJoCo camera at `position`, `rotation` (its axes as columns:
+    x right, y up, looking down -z): pixels and whether each is in front and in the image."""
+    local = (points - position) @ rotation
+    depth = -local[:, 2]
+    safe = np.where(depth > 0.5, depth, 1.0)
+    u = cam.cx + cam.fx * local[:, 0] / safe
+    v = cam.cy - cam.fy * local[:, 1] / safe
+    inside = (depth > 0.5) & (u >= 0) & (u < cam.width) & (v >= 0) & (v < cam.height)
+    return np.stack([u, v], axis=1), inside
+
+
+def _ground_probes(cam: CameraModel, position: np.ndarray, rotation: np.ndarray) -> np.ndarray:
+    """Where rays through a grid of the image's lower pixels meet the ground (z = 0)."""
+    u = np.linspace(0.0, cam.width - 1.0, PROBE_COLUMNS)
+    v = np.linspace(cam.height - 1.0, 0.75 * cam.height, PROBE_ROWS)
+    uu, vv = np.meshgrid(u, v)
+    rays_cam = np.stack(
+        [(uu.ravel() - cam.cx) / cam.fx, -(vv.ravel() - cam.cy) / cam.fy, -np.ones(uu.size)],
+        axis=1,
+    )
+    rays = rays_cam @ rotation.T
+    down = rays[:, 2] < -1e-6
+    t = -position[2] / np.where(down, rays[:, 2], -1.0)
+    return (position + t[:, None] * rays)[down]
+
+
 class Scene:
     """A compiled street scene with its bodies; exactly one of them is the camera robot.
 
@@ -181,6 +225,60 @@ class Scene:
     def geoms_of(self, entity: Entity) -> np.ndarray:
         """The geom ids of one body (for a segmentation mask, an occlusion test)."""
         return entity.geom_ids(self.model)
+
+    # -- between two moments (the exposure window: sim.world.shutter) -------------------
+
+    def snapshot(self) -> SceneState:
+        """The placed state now, to come back to or blend from."""
+        d = self.data
+        return SceneState(d.qpos.copy(), d.mocap_pos.copy(), d.mocap_quat.copy())
+
+    def blend(self, a: SceneState, b: SceneState, w: float) -> None:
+        """Put every body `w` of the way from state `a` to state `b` (0: a, 1: b) and run
+        the kinematics: positions and joint angles linearly, orientations by normalised
+        linear blending of their quaternions (within a frame they turn by a few degrees,
+        where it and the spherical blend agree to far below a pixel)."""
+        d = self.data
+        d.qpos[:] = a.qpos + w * (b.qpos - a.qpos)
+        for adr in self._quat_slots:
+            q = d.qpos[adr : adr + 4]
+            q /= np.linalg.norm(q)
+        d.mocap_pos[:] = a.mocap_pos + w * (b.mocap_pos - a.mocap_pos)
+        qa, qb = a.mocap_quat, b.mocap_quat
+        sign = np.where(np.sum(qa * qb, axis=1, keepdims=True) < 0, -1.0, 1.0)
+        q = qa + w * (sign * qb - qa)
+        d.mocap_quat[:] = q / np.linalg.norm(q, axis=1, keepdims=True)
+        self.update()
+
+    @cached_property
+    def _quat_slots(self) -> list[int]:
+        """qpos addresses of the free and ball joints' quaternions."""
+        m = self.model
+        slots = []
+        for j in range(m.njnt):
+            kind = m.jnt_type[j]
+            if kind == mujoco.mjtJoint.mjJNT_FREE:
+                slots.append(int(m.jnt_qposadr[j]) + 3)
+            elif kind == mujoco.mjtJoint.mjJNT_BALL:
+                slots.append(int(m.jnt_qposadr[j]))
+        return slots
+
+    def image_motion(self, a: SceneState, b: SceneState) -> float:
+        """The largest image motion (pixels) from state `a` to `b` of what the camera sees:
+        every geom's centre and the ground along the lower image, each through the camera
+        as it was then. Leaves the scene at `b`."""
+        cam, cid, data = self.camera, self.robot.camera_id, self.data
+        seen = []
+        for state in (a, b):
+            self.blend(state, state, 1.0)
+            seen.append((data.cam_xpos[cid].copy(), data.cam_xmat[cid].reshape(3, 3).copy(),
+                         data.geom_xpos.copy()))  # fmt: skip
+        ground = _ground_probes(cam, seen[1][0], seen[1][1])
+        (uv_a, ok_a), (uv_b, ok_b) = (
+            _pixels(cam, pos, mat, np.vstack([geoms, ground])) for pos, mat, geoms in seen
+        )
+        ok = ok_a & ok_b
+        return float(np.max(np.linalg.norm(uv_b[ok] - uv_a[ok], axis=1))) if ok.any() else 0.0
 
     def world_to_robot(self, points_world: np.ndarray) -> np.ndarray:
         """World points (..., 3) in the robot frame of monopic.camera."""

@@ -24,7 +24,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 from highway_env.road.road import Road
@@ -33,6 +33,7 @@ from monopic.camera import CameraModel
 from monopic.closing import Closing
 from monopic.frame import EgoState, Frame
 from sim.scenario.spec import Scenario, person_name
+from sim.sensor.sensor import Sensor
 from sim.world.entities.base import Entity, Moment, Sight
 from sim.world.entities.crowd import CrowdDirector
 from sim.world.entities.pedestrian import PedestrianBody
@@ -43,6 +44,7 @@ from sim.world.pedestrian import Pedestrian
 from sim.world.render import Marker, RenderContext, SceneRenderer
 from sim.world.robot import Robot, highway_road
 from sim.world.scene import Scene, SceneConfig, parked_cars
+from sim.world.shutter import Shutter
 
 TTC_LOOKAHEAD = 10.0  # s: how far ahead the time to collision is searched
 
@@ -107,6 +109,14 @@ class World(Closing):
         self._geom_kinds = self.scene.geom_kinds()
         self.camera: CameraModel = self.scene.camera
         self._renderer: SceneRenderer | None = None
+        # A real camera's sensor exposes each frame (sim.world.shutter); the ideal camera
+        # (None) gives the renderer's frames as they are.
+        sensor = scenario.robot.camera.sensor
+        self.shutter: Shutter | None = None
+        if sensor is not None and render:
+            lux = scenario.scene.lighting.illuminance_lux
+            self.shutter = Shutter(Sensor(sensor, lux, scenario.dt, scenario.seed), self.scene)
+        self._frame_time = 0.0
         self.road: Road | None = None
         self.time = 0.0
         self.index = 0
@@ -150,6 +160,8 @@ class World(Closing):
         self.road = highway_road(self.scenario.scene.road)
         for entity in self.entities:
             entity.reset(self.road, rng, self.seed)
+        if self.shutter is not None:
+            self.shutter.reset(self.seed)
         self.time, self.index = 0.0, 0
         return self._observe()
 
@@ -225,7 +237,15 @@ class World(Closing):
         self.scene.place(Moment(self.time, robot.pose))
         truth = self._ground_truth(robot)
         ego = EgoState(self.camera, robot.speed, robot.yaw_rate)
-        frame = Frame(self.render(), self.time, ego, self.index) if self.render_frames else None
+        frame = None
+        if self.shutter is not None:
+            interval = self.time - self._frame_time if self.index else 0.0
+            image, exposure = self.shutter.capture(self.render, interval)
+            truth = replace(truth, camera=exposure)
+            frame = Frame(image, self.time, ego, self.index)
+        elif self.render_frames:
+            frame = Frame(self.render(), self.time, ego, self.index)
+        self._frame_time = self.time
         self.last = WorldStep(self.index, self.time, ego, truth, frame)
         return self.last
 
