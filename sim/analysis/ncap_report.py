@@ -13,6 +13,7 @@ for the wrong person (nobody, or someone not on a collision course) apart from t
 
 from __future__ import annotations
 
+import json
 import math
 from collections import defaultdict
 from collections.abc import Sequence
@@ -22,11 +23,20 @@ from typing import Any
 
 import numpy as np
 
+from monopic.errors import UserError
 from monopic.output import atomic_path
-from sim.analysis.ncap_score import CalculatorScore, Cell, band_colour, percent
+from sim.analysis.ncap_score import (
+    CalculatorScore,
+    Cell,
+    band_colour,
+    calculator_version,
+    percent,
+    read_report,
+)
 from sim.analysis.triage import Rerunning, ncap_triage_lines
 from sim.runs.ncap_grid import DECLARED, GRID, MEASURED, NEAR_MISS, VERIFY, LatencySetting
 from sim.scenario.ncap import CarSpec, Protocol
+from sim.sensor.spec import IDEAL
 from sim.world.warned_for import NOBODY
 
 COLOURS = {  # the calculator's own RGB (common.PREDICTION_COLOR_MAP)
@@ -321,6 +331,55 @@ def points_table(points: Sequence[PointSummary], policy: str) -> str:
     return "\n".join(lines)
 
 
+@dataclass(frozen=True)
+class Beside:
+    """Another grid's calculator points (e.g. the same grid under the ideal camera)."""
+
+    folder: Path
+    camera: str
+    scores: dict[str, CalculatorScore]
+
+
+def beside_scores(folder: Path) -> Beside:
+    """The points another `monopic ncap` output folder's calculator wrote, per policy, and
+    the camera its runs had; a folder that holds no scored grid is refused in one line."""
+    results = folder / "results.jsonl"
+    reports = sorted((folder / "calculator").glob("*/ca_*_report.xlsx"))
+    if not results.is_file() or not reports:
+        raise UserError(
+            f"--beside {folder}: no scored grid there (results.jsonl and "
+            "calculator/*/ca_*_report.xlsx, as monopic ncap --out writes them)"
+        )
+    camera = IDEAL
+    with results.open() as f:
+        for line in f:
+            row = json.loads(line)
+            if "outcome" in row:
+                camera = str(row.get("camera", IDEAL))
+                break
+    version = calculator_version() or "?"
+    scores = {}
+    for report in reports:
+        policy = report.parent.name.replace("-", "/", 1)
+        scores[policy] = read_report(report, version)
+    return Beside(folder, camera, scores)
+
+
+def camera_line(car: Any, beside: Beside | None) -> str:
+    """Which camera the grid saw, and which the other grid beside it saw."""
+    name = car.camera_name
+    text = (
+        "Camera: the ideal camera (the renderer's frames as they are)."
+        if name == IDEAL
+        else f"Camera: {name} (sim.sensor: exposure and auto-exposure, motion blur over the "
+        "exposure, shot and read noise, gain, 12-bit digitiser, tone curve; "
+        "scenarios/README.md gives its figures and their sources)."
+    )
+    if beside is not None:
+        text += f" Beside it: the same calculator's points under the {beside.camera} camera."
+    return text
+
+
 def score_table(scores: dict[str, CalculatorScore], claimed: set[str]) -> str:
     """The calculator's points per load case (tests not run: not claimed, "-")."""
     lines = [
@@ -341,6 +400,17 @@ def score_table(scores: dict[str, CalculatorScore], claimed: set[str]) -> str:
             f"{s.pedestrian_max:g} | {s.ped_cyc_score:.3g} / {s.ped_cyc_max:g} |"
         )
     return "\n".join(lines)
+
+
+def _beside_lines(beside: Beside | None, claimed: set[str]) -> list[str]:
+    if beside is None:
+        return []
+    return [
+        f"The same grid under the {beside.camera} camera (`{beside.folder}`):",
+        "",
+        score_table(beside.scores, claimed),
+        "",
+    ]
 
 
 def recall_lead(rows: Sequence[dict[str, Any]], policy: str) -> tuple[int, int, float | None]:
@@ -370,6 +440,7 @@ def render(
     left_unscored: str,
     out: Path,
     latency: LatencySetting,
+    beside: Beside | None = None,
 ) -> str:
     """DIR/report.md: the calculator's points first, then how they came about."""
     grid_runs = sum(r["role"] == GRID for r in rows)
@@ -392,6 +463,8 @@ def render(
         "",
         latency_line(latency, car, rows),
         "",
+        camera_line(car, beside),
+        "",
         f"Scored by the official rating calculator euroncap-rating-2026 {version} "
         "(`crash_avoidance generate-template`, `preprocess`, `compute-score`; files in "
         f"`{out.name}/calculator/`). Protocol: {protocol.protocol}.",
@@ -403,6 +476,7 @@ def render(
         "",
         score_table(scores, {protocol.tests[t].load_case.split(" ")[0] for t in tests}),
         "",
+        *_beside_lines(beside, {protocol.tests[t].load_case.split(" ")[0] for t in tests}),
         f"Left unscored: {left_unscored}.",
         "",
     ]

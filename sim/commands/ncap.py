@@ -5,6 +5,7 @@ from __future__ import annotations
 import argparse
 import shutil
 import time
+from dataclasses import replace
 from pathlib import Path
 
 from monopic.cli.args import deprecated_alias, non_negative_float, output_folder, positive_int
@@ -17,6 +18,7 @@ from sim.commands.executor_options import (
     make_executor,
 )
 from sim.commands.tracker_option import add_tracker_option
+from sim.sensor.spec import PRESETS as CAMERAS
 
 PROTOCOL = Path("scenarios/ncap/protocol.toml")
 CAR = Path("scenarios/ncap/car.toml")
@@ -85,6 +87,20 @@ def register(sub: argparse._SubParsersAction) -> None:
         "declared one (the score then moves with the host's speed and load)",
     )
     add_tracker_option(p, "rating")
+    p.add_argument(
+        "--camera",
+        choices=tuple(CAMERAS),
+        help="the camera's sensor preset for every run (default: the car file's [camera] "
+        "preset; ideal: the renderer's frames as they are, as every grid before the camera "
+        "model had)",
+    )
+    p.add_argument(
+        "--beside",
+        type=Path,
+        metavar="DIR",
+        help="another grid's output folder (e.g. the same grid under the ideal camera): its "
+        "calculator points are shown beside this grid's in the report",
+    )
     add_executor_options(p)
     p.add_argument("--restart", action="store_true", help="set aside other code's results")
     p.add_argument(
@@ -123,6 +139,11 @@ def run(args: argparse.Namespace) -> int:
     version = require_calculator()
     protocol = load_protocol(args.protocol)
     car = load_car(args.car)
+    if args.camera is not None:
+        car = replace(car, sensor=CAMERAS[args.camera])
+    from sim.analysis.ncap_report import beside_scores
+
+    beside = None if args.beside is None else beside_scores(args.beside)
     tests = [t.strip().lower() for t in args.tests.split(",") if t.strip()]
     for t in tests:
         if t not in protocol.tests:
@@ -220,6 +241,7 @@ def run(args: argparse.Namespace) -> int:
         left_unscored=LEFT_UNSCORED,
         out=args.out,
         latency=latency,
+        beside=beside,
     )
     write_text_atomically(args.out / "report.md", text)
     print(rep.score_table(scores, claimed))
@@ -245,5 +267,9 @@ def _command(args: argparse.Namespace) -> str:
         parts.append("--measured-latency")
     if args.tracker != "one":
         parts.append(f"--tracker {args.tracker}")
+    if args.camera is not None:
+        parts.append(f"--camera {args.camera}")
+    if args.beside is not None:
+        parts.append(f"--beside {args.beside}")
     parts.append(f"--out {args.out}")
     return " ".join(parts)

@@ -18,6 +18,10 @@ row says which it applied (`latency`) and keeps the pipeline's measured latency 
 frame (`outcome.latencies_ms`), so the report shows the host's latency beside the
 declared one and a run made with the measured latency can be replayed exactly.
 
+The camera (`camera`: the car file's sensor preset, or the command's `--camera`) changes
+every scenario's identity, so the ideal camera's and a real one's runs never mix; a row
+names it only when it is a real camera.
+
 The tracker (`tracker`: one pedestrian or everyone, sim.runs.run_spec.TRACKERS) enters a
 run's id and line only when it is the people tracker, so a one-tracker grid keeps the ids
 and lines it always had (sim.runs.closed_loop.OPTIONAL for the outcome's fields).
@@ -52,6 +56,7 @@ from sim.scenario.ncap import (
     scenario_for,
 )
 from sim.scenario.spec import Scenario
+from sim.sensor.spec import IDEAL, preset
 from sim.world.render import KeptRenderContext
 
 SCHEMA = 1
@@ -170,7 +175,8 @@ def near_miss_run(
 ) -> NcapRun:  # fmt: skip
     """Seed `k` of a car-scale near miss at `speed_kmh`, braking as the car does."""
     base = sf.scenario({"robot.speed": speed_kmh * KMH}, name=sf.name)
-    robot = replace(base.robot, max_deceleration=car.deceleration, pitch=car.pitch)
+    camera = replace(base.robot.camera, sensor=car.sensor)
+    robot = replace(base.robot, max_deceleration=car.deceleration, pitch=car.pitch, camera=camera)
     s = replace(base, robot=robot, seed=k)
     meta = {"test": "near-miss", "family": sf.name, "speed_kmh": speed_kmh}
     key = f"{sf.name}/{speed_kmh:g}kmh"
@@ -187,6 +193,8 @@ def _run(protocol: Protocol, car: CarSpec, policy: str, key: str, role: str, k: 
     meta["lighting"] = s.scene.lighting.name
     if tracker != ONE:  # only the people tracker's lines say it (OPTIONAL's rule)
         meta["tracker"] = tracker
+    if car.sensor is not None:  # only a real camera's lines say it, as with the tracker
+        meta["camera"] = car.sensor.name
     return NcapRun(
         rid, replace(s, name=rid), policy, aeb, role, k, meta, latency=latency, tracker=tracker
     )
@@ -201,6 +209,9 @@ def run_of(protocol: Protocol, car: CarSpec, row: dict[str, Any]) -> NcapRun:
     tracker = str(row.get("tracker", ONE))
     if tracker not in TRACKERS:
         raise ValueError(f"tracker {tracker!r}")
+    camera = str(row.get("camera", IDEAL))
+    if camera != car.camera_name:  # a grid run under another camera than the car file's
+        car = replace(car, sensor=preset(camera))
     if role == NEAR_MISS:
         for path in protocol.near_misses.files:
             sf = load(path)

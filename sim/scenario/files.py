@@ -61,6 +61,7 @@ from sim.scenario.people import (
     start_overlap,
 )
 from sim.scenario.replays import REPLAY_KEY, expand_replay, replay_person, replay_street_problem
+from sim.scenario.sensor_table import read_sensor
 from sim.scenario.spec import (
     BodyPitch,
     CameraSpec,
@@ -75,6 +76,7 @@ from sim.scenario.spec import (
 )
 from sim.scenario.toml_table import MISSING, FieldError, TomlTable, read_toml, show
 from sim.scenario.walkers import ReplayWalker, Walker, walker_from_table
+from sim.sensor.spec import SensorSpecError
 
 KINDS = ("case", "collision", "near-miss")
 PATH_KINDS = ("case", "crossing", "longitudinal", "turn-in", "explicit", "pavement")
@@ -655,6 +657,7 @@ def build(
     fps = top.number("fps", presets.FPS, low=fps_low, high=fps_high, unit="frames/s")
     seed = top.integer("seed", 0, high=2**31 - 1)
     robot = _robot(top.table("robot"), preset.robot)
+    _check_frame_rate(top, robot, fps)
     road, lighting = _scene(top.table("scene"), preset.road)
     tables = _people_tables(top)
     people: list[PedestrianSpec] = []
@@ -782,6 +785,20 @@ def _robot(t: TomlTable, preset: RobotSpec) -> RobotSpec:
     return robot
 
 
+def _check_frame_rate(top: TomlTable, robot: RobotSpec, fps: float) -> None:
+    """A real camera keeps the file's frame rate and exposes within its frame interval."""
+    sensor = robot.camera.sensor
+    if sensor is None:
+        return
+    try:
+        sensor.check_frame_rate(1.0 / fps)
+    except SensorSpecError as err:
+        if err.field == "fps":
+            raise top.error("fps", fps, err.why) from None
+        camera = top.table("robot").table("camera")
+        raise camera.error(err.field, err.value, err.why) from None
+
+
 def _pitch(t: TomlTable, preset: BodyPitch) -> BodyPitch:
     """[robot.pitch]: the body's nose dip when braking (sim.scenario.spec.BodyPitch)."""
     pitch = BodyPitch(
@@ -803,6 +820,7 @@ def _camera(t: TomlTable, preset: CameraSpec) -> CameraSpec:
         mount_height=t.number("mount_height", preset.mount_height, low=0.2, high=4.0, unit="m"),
         pitch_deg=t.number("pitch_deg", preset.pitch_deg, low=-30.0, high=45.0, unit="degrees"),
         mount_forward=t.number("mount_forward", preset.mount_forward, low=-5.0, high=5.0, unit="m"),
+        sensor=read_sensor(t, preset.sensor),
     )
     t.done()
     return camera

@@ -37,6 +37,7 @@ from sim.scenario.families import (
     place_crossing,
     place_longitudinal,
 )
+from sim.scenario.sensor_table import read_sensor
 from sim.scenario.spec import (
     BodyPitch,
     RobotSpec,
@@ -46,6 +47,7 @@ from sim.scenario.spec import (
 )
 from sim.scenario.toml_table import FieldError, TomlTable, read_toml
 from sim.scenario.walkers import RailWalker
+from sim.sensor.spec import IDEAL, SensorSpec
 
 PROTOCOL_FILE = Path("scenarios/ncap/protocol.toml")
 CAR_FILE = Path("scenarios/ncap/car.toml")
@@ -155,6 +157,12 @@ class CarSpec:
     deceleration: float
     latency_ms: float | None
     pitch: BodyPitch
+    # The camera's sensor (sim.sensor; None: the ideal camera, the renderer's frames).
+    sensor: SensorSpec | None = None
+
+    @property
+    def camera_name(self) -> str:
+        return IDEAL if self.sensor is None else self.sensor.name
 
 
 @dataclass(frozen=True)
@@ -315,7 +323,7 @@ def load_car(path: Path | str = CAR_FILE) -> CarSpec:
     path = Path(path)
     _, data = read_toml(path, "NCAP car file")
     top = TomlTable(path, "", data, DOC)
-    aeb, pitch = top.table("aeb"), top.table("pitch")
+    aeb, pitch, camera = top.table("aeb"), top.table("pitch"), top.table("camera")
     policies = _texts(top, "policies")
     primary = top.text("primary")
     for policy in (primary, *policies):
@@ -341,9 +349,11 @@ def load_car(path: Path | str = CAR_FILE) -> CarSpec:
             frequency=pitch.number("frequency", low=0.2, high=10.0, unit="Hz"),
             damping=pitch.number("damping", low=0.05, high=5.0),
         ),
+        sensor=read_sensor(camera, None),
     )
     aeb.done()
     pitch.done()
+    camera.done()
     top.done()
     return car
 
@@ -396,6 +406,7 @@ def car_robot(car: CarSpec, speed: float) -> RobotSpec:
         max_speed=car.max_speed,
         max_deceleration=car.deceleration,
         pitch=car.pitch,
+        camera=replace(CAR.robot.camera, sensor=car.sensor),
     )
 
 
