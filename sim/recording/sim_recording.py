@@ -24,7 +24,8 @@ really going to happen) reads at a glance. Entities added to RunRecording's:
   same entities, a state lane each (StateChange: clear / collision course / contact for
   the truth; clear / near / WARNING / no decision for a predictor) so warnings line up
   against the truth at a glance; robot/speed and truth/gap (footprint distance),
-  brake/command (closed loop);
+  brake/command (closed loop); with a real camera (sim.sensor) sensor/exposure_ms,
+  sensor/gain and sensor/subframes, the exposure each frame was taken with;
 - events: first frame on a collision course, contact, pose found and lost, each
   predictor's warning onset, whom the robot's warning is for by the truth (at its onset
   and whenever it passes to another track: the track's id and box colour, the person it
@@ -127,13 +128,23 @@ def sim_blueprint(
     width: int | None = None,
     height: int | None = None,
     eye: rrb.EyeControls3D | None = None,
+    sensor: bool = False,
 ) -> rrb.Blueprint:
     """Camera big on the left; 3D world over the top-down view on the right; plots below.
 
     The camera view is framed on the width x height image when given; `eye` places the 3D
     view's eye (see `world_eye`); every plot and the warning lanes show the whole run.
+    `sensor`: a real camera's exposure, gain and sub-frame draws get a plot of their own.
     """
     bounds = image_bounds(width, height) if width and height else None
+    sensor_views = [
+        rrb.TimeSeriesView(
+            origin="sensor",
+            name="camera: exposure (ms), gain, sub-frame draws",
+            plot_legend=TOP_LEFT,
+            axis_x=WHOLE_RUN,
+        )
+    ] if sensor else []  # fmt: skip
     return rrb.Blueprint(
         rrb.Vertical(
             rrb.Horizontal(
@@ -194,7 +205,8 @@ def sim_blueprint(
                         plot_legend=TOP_LEFT,
                         axis_x=WHOLE_RUN,
                     ),
-                    row_shares=[3, 2],
+                    *sensor_views,
+                    row_shares=[3, 2, 2] if sensor else [3, 2],
                 ),
                 column_shares=[4, 3, 3, 4],
             ),
@@ -324,7 +336,8 @@ class SimRecording(WholeOrNothing):
             cam = self.world.camera
             r = step.truth.robot
             eye = world_eye(r.position, r.yaw, self._meeting_point(step))
-            self.run.start(sim_blueprint(cam.width, cam.height, eye))
+            sensor = self.scenario.robot.camera.sensor is not None
+            self.run.start(sim_blueprint(cam.width, cam.height, eye, sensor=sensor))
         rec.log("world", rr.ViewCoordinates.RIGHT_HAND_Z_UP, static=True)
         skeleton = skeleton_context("pedestrian", PEDESTRIAN_COLOUR)
         rec.log("world/pedestrian", skeleton, static=True)
@@ -711,6 +724,10 @@ class SimRecording(WholeOrNothing):
         )
         rec.log("robot/speed", rr.Scalars(truth.robot.speed))
         rec.log("truth/gap", rr.Scalars(footprint_gap(truth, self.scenario.pedestrian.footprint)))
+        if truth.camera is not None:  # a real camera's exposure of this frame (sim.sensor)
+            rec.log("sensor/exposure_ms", rr.Scalars(1000.0 * truth.camera.exposure_s))
+            rec.log("sensor/gain", rr.Scalars(truth.camera.gain))
+            rec.log("sensor/subframes", rr.Scalars(float(truth.camera.subframes)))
 
     def _log_events(self, step: WorldStep, result: FrameResult | None) -> None:
         truth = step.truth

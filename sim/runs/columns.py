@@ -16,6 +16,7 @@ from monopic.pipeline import Decision, FrameResult, worst_for
 from sim.runs.loop import Listener, LoopFrame
 from sim.runs.result import (
     DecisionColumns,
+    ExposureColumns,
     PersonColumns,
     PipelineColumns,
     TrackColumns,
@@ -52,11 +53,23 @@ class TruthRecorder(Listener):
     # Every person's columns even with one person: the people tracker's warnings are
     # matched to people by their boxes (sim.analysis.people).
     every_person: bool = False
+    exposure: ExposureColumns | None = None  # a real camera's, frame by frame
 
     def frame(self, frame: LoopFrame) -> None:
         self.add(frame.truth)
+        if frame.truth.camera is not None:
+            self.add_exposure(frame.truth)
         if len(frame.truth.people) > 1 or self.every_person:
             self.add_people(frame.truth)
+
+    def add_exposure(self, truth: GroundTruth) -> None:
+        state = truth.camera
+        assert state is not None
+        e = self.exposure = self.exposure or ExposureColumns()
+        e.exposure_ms.append(rounded(1000.0 * state.exposure_s, 4))
+        e.gain.append(rounded(state.gain, 3))
+        e.subframes.append(int(state.subframes))
+        e.signal.append(rounded(state.signal, 4))
 
     def add_people(self, truth: GroundTruth) -> None:
         if not self.people:

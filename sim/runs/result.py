@@ -21,6 +21,8 @@ Growing it (one rule for every growth: the lighting, several people, the camera)
   and the decision behind it (with the one-pedestrian tracker: its one person's; with
   the people tracker, `tracker` = "everyone": each predictor's worst person's, whose
   identity is in `tracks`).
+- A real camera (sim.sensor): `exposure` holds each frame's exposure time, gain, sub-frame
+  draws and mean signal; ideal-camera lines have none.
 - SCHEMA goes up when a field is renamed, removed or changes meaning or units: lines of
   another schema are then refused with one line saying how to redo them, never read as
   if they meant the new thing.
@@ -76,6 +78,16 @@ class TruthColumns:
     # case of the velocity now (the current-velocity baseline). Empty on lines before them.
     intent: list[str | None] = field(default_factory=list)
     case_now: list[int | None] = field(default_factory=list)
+
+
+@dataclass
+class ExposureColumns:
+    """A real camera's exposure per frame (sim.sensor): what each frame was taken with."""
+
+    exposure_ms: list[float | None] = field(default_factory=list)
+    gain: list[float | None] = field(default_factory=list)
+    subframes: list[int] = field(default_factory=list)  # renders averaged over the exposure
+    signal: list[float | None] = field(default_factory=list)  # mean linear signal, 0-1
 
 
 @dataclass
@@ -217,6 +229,8 @@ class RunResult:
     # person, so every warning can be matched to a person.
     tracker: str = ""
     tracks: dict[str, TrackColumns] = field(default_factory=dict)
+    # Runs under a real camera only (OPTIONAL): the exposure of every frame.
+    exposure: ExposureColumns | None = None
 
     # JSON key order of a line (the fields above in the order lines have always had).
     ORDER = (
@@ -225,7 +239,7 @@ class RunResult:
     )  # fmt: skip
 
     # Keys written only on the lines of runs that have them (see "Growing it").
-    OPTIONAL = ("people", "first_threat", "tracker", "tracks")
+    OPTIONAL = ("people", "first_threat", "tracker", "tracks", "exposure")
 
     def to_json(self) -> dict[str, Any]:
         """The line as JSON-ready data (plain dicts and lists)."""
@@ -235,6 +249,8 @@ class RunResult:
             line.update({k: plain[k] for k in ("people", "first_threat")})
         if self.tracker:
             line.update({k: plain[k] for k in ("tracker", "tracks")})
+        if self.exposure is not None:
+            line["exposure"] = plain["exposure"]
         return line
 
     def deterministic(self) -> dict[str, Any]:

@@ -171,6 +171,7 @@ def run(
         pipelines={name: r.finished() for name, r in recorders.items()},
         tracker=EVERYONE if everyone else "",
         tracks={n: r.tracks for n, r in recorders.items() if r.tracks is not None},
+        exposure=truth.exposure,
         timing=Timing(
             wall_s=round(time.perf_counter() - start, 3),
             sim_ms=[round(v, 2) for v in times.ms],

@@ -1,17 +1,18 @@
 """A real camera's exposure window: the scene rendered over it and read by the sensor.
 
 Motion blur comes from sub-frame renders: the scene is put part of the way between the
-last frame's state and this one (sim.world.scene.Scene.blend) at moments spread over the
-exposure, which ends at the frame's time, each drawn and the draws averaged in linear
-light. How many: enough that the largest image motion over the exposure (Scene.image_motion:
-every body's centre and the near ground, seen by the camera as it moved) is sampled at
-least every `blur_step_px` pixels, and one draw when it moves less than half of that, so a
-daylight exposure of a millisecond costs one render. A blur drawn from a per-pixel motion
-field instead needs that field, which MuJoCo does not give: a segmentation render and a
-depth read every frame, costing about what a second render costs whether anything moves
-or not (bench/simulator.py's camera rows), and it smears the wrong way where a moving body
-passes in front of another. The first frame of a run has no earlier state and is drawn
-sharp.
+last frame's state and this one (sim.world.scene.Scene.blend) at moments spread evenly
+over the exposure from its start to its end (the frame's time), each drawn and the draws
+averaged in linear light, so an edge smears over the whole distance it moved. How many:
+enough that the largest image motion over the exposure (Scene.image_motion: every body's
+centre and the near ground, seen by the camera as it moved) is sampled at least every
+`blur_step_px` pixels, and one draw when it moves less than half of that, so a daylight
+exposure of a fraction of a millisecond costs one render. A blur drawn from a per-pixel
+motion field instead needs that field, which MuJoCo does not give: a segmentation render
+and a depth read every frame, costing about what a second render costs whether anything
+moves or not (bench/simulator.py's camera rows), and it smears the wrong way where a
+moving body passes in front of another. The first frame of a run has no earlier state
+and is drawn sharp.
 """
 
 from __future__ import annotations
@@ -72,7 +73,7 @@ class Shutter:
             assert previous is not None
             light = np.zeros((scene.camera.height, scene.camera.width, 3), np.float32)
             for k in range(draws):
-                scene.blend(previous, current, 1.0 - share * (1.0 - (k + 0.5) / draws))
+                scene.blend(previous, current, 1.0 - share * (1.0 - k / (draws - 1)))
                 light += linear_light(render())
             scene.blend(current, current, 1.0)
             light *= np.float32(1.0 / draws)
