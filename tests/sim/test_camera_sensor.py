@@ -279,3 +279,37 @@ def test_the_car_file_names_its_camera_and_bad_names_are_refused(tmp_path: Path)
     bad.write_text(text)
     with pytest.raises(FieldError, match="camera.preset = 'gopro': must be one of ideal, imx273"):
         load_car(bad)
+
+
+# -- the camera's state in results and recordings -------------------------------------
+
+
+@pytest.mark.slow
+def test_a_real_cameras_exposure_is_in_the_result_line_and_the_recording(tmp_path: Path) -> None:
+    from monopic.cases import Case
+    from sim.runs.record import record_run
+    from sim.runs.result import RunResult
+    from sim.runs.run_spec import RunSpec
+    from sim.runs.runner import run
+    from sim.scenario.cases import CasePlacement
+    from tests.sim.test_sim_recording import blueprint_views, values
+
+    base = CasePlacement(Case(5), duration=0.6, seed=2).scenario()
+    real = with_sensor(base, IMX273)
+    result = run(RunSpec(id="real", scenario=real, stop_at_contact=False))
+    assert result.exposure is not None
+    exposure = result.exposure
+    assert len(exposure.exposure_ms) == result.frames == len(exposure.gain)
+    assert all(0 < ms <= IMX273.max_exposure_ms for ms in exposure.exposure_ms)
+    again = RunResult.from_json(result.to_json())
+    assert again.exposure == result.exposure
+    ideal = run(RunSpec(id="ideal", scenario=base, stop_at_contact=False))
+    assert ideal.exposure is None and "exposure" not in ideal.to_json()
+
+    rrd = tmp_path / "real.rrd"
+    record_run(real, rrd, stop_at_contact=False)
+    logged = values(rrd, "/sensor/exposure_ms")
+    assert len(logged) == result.frames
+    assert logged == pytest.approx(exposure.exposure_ms, abs=1e-3)
+    views = blueprint_views(rrd)
+    assert views["camera: exposure (ms), gain, sub-frame draws"]["origin"] == "sensor"
