@@ -313,3 +313,14 @@ def test_a_real_cameras_exposure_is_in_the_result_line_and_the_recording(tmp_pat
     assert logged == pytest.approx(exposure.exposure_ms, abs=1e-3)
     views = blueprint_views(rrd)
     assert views["camera: exposure (ms), gain, sub-frame draws"]["origin"] == "sensor"
+
+
+def test_compression_changes_the_frame_a_little() -> None:
+    light = np.tile(np.linspace(0.02, 0.6, 96, dtype=np.float32)[None, :, None], (64, 1, 3))
+    spec = replace(IMX273, exposure_ms=0.2, gain=1.0, noise=False)
+    sharp, _ = Sensor(spec, 32000.0, 1 / 15, seed=0).read(light, ExposureState(2e-4, 1.0))
+    jpeg, _ = Sensor(replace(spec, jpeg_quality=30), 32000.0, 1 / 15, seed=0).read(
+        light, ExposureState(2e-4, 1.0)
+    )
+    diff = np.abs(sharp.astype(int) - jpeg.astype(int))
+    assert diff.max() > 0 and diff.mean() < 3

@@ -181,6 +181,7 @@ def test_the_calculator_scores_hand_made_cases(tmp_path):
         (["--speeds-kmh", "25"], "--speeds-kmh 25: not a test speed"),
         (["--speeds-kmh", "fast"], "--speeds-kmh: expected km/h numbers separated by commas"),
         (["--policies", "oracle"], "--policies: 'oracle' is not PREDICTOR/MODE"),
+        (["--beside", "no/such/grid"], "--beside no/such/grid: no scored grid there"),
     ],
 )
 def test_bad_input_is_one_line_and_writes_nothing(tmp_path, capsys, argv, expected):
