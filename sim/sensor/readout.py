@@ -34,7 +34,33 @@ LINEAR_OF_U8 = srgb_decode(np.arange(256) / 255.0).astype(np.float32)
 
 def linear_light(image: np.ndarray) -> np.ndarray:
     """A rendered 8-bit frame as linear light (float32, same shape)."""
-    return LINEAR_OF_U8[image]
+    return cv2.LUT(image, LINEAR_OF_U8)  # a few times faster than numpy's indexing
+
+
+POOL_SIZE = 1 << 22  # standard normal deviates a sensor draws once per run (16 MB)
+
+
+class NoisePool:
+    """Standard normal deviates for a run's frames: a pool drawn once from the run's
+    stream, each frame a slice of it at a random offset.
+
+    Drawing a million Gaussian deviates costs about 20 ms on one core (bench/simulator.py's
+    camera rows), as much as the rest of the frame's readout; a slice costs nothing. Within
+    a frame the deviates are independent; two frames share deviates only shifted by the
+    difference of their offsets (a pixel's noise in one frame is another pixel's in the
+    next), which no detector can use. A frame larger than the pool draws afresh.
+    """
+
+    def __init__(self, rng: np.random.Generator, size: int = POOL_SIZE) -> None:
+        self.rng = rng
+        self.pool = rng.standard_normal(size, dtype=np.float32)
+
+    def draw(self, shape: tuple[int, ...]) -> np.ndarray:
+        n = int(np.prod(shape))
+        if n > self.pool.size:
+            return self.rng.standard_normal(shape, dtype=np.float32)
+        start = int(self.rng.integers(0, self.pool.size - n + 1))
+        return self.pool[start : start + n].reshape(shape)
 
 
 class Readout:
@@ -52,7 +78,7 @@ class Readout:
         electrons_per_s: float,
         exposure_s: float,
         gain: float,
-        rng: np.random.Generator,
+        normals: NoisePool,
     ) -> tuple[np.ndarray, float]:
         """The 8-bit frame and its mean linear signal (share of full scale, the meter's)
         for linear `light` (float32, H x W x 3) exposed `exposure_s` at `gain`."""
@@ -60,13 +86,14 @@ class Readout:
         electrons = light * np.float32(electrons_per_s * exposure_s)
         if spec.noise:
             sigma = np.sqrt(electrons + np.float32(spec.read_noise_e**2))
-            electrons += sigma * rng.standard_normal(light.shape, dtype=np.float32)
+            sigma *= normals.draw(light.shape)
+            electrons += sigma
         np.clip(electrons, 0.0, spec.full_well_e, out=electrons)
         electrons *= np.float32(gain * spec.levels / spec.full_well_e)
         np.clip(electrons, 0.0, spec.levels, out=electrons)
         codes = np.rint(electrons).astype(np.uint16)
         signal = float(codes[::METER_STRIDE, ::METER_STRIDE].mean()) / spec.levels
-        image = self._tone[codes]
+        image = np.take(self._tone, codes)  # faster than indexing for 16-bit codes
         if spec.jpeg_quality:
             image = compress(image, spec.jpeg_quality)
         return image, signal

@@ -6,7 +6,7 @@ import numpy as np
 
 from sim.sensor.exposure import AutoExposure, ExposureState
 from sim.sensor.photometry import electrons_per_second
-from sim.sensor.readout import Readout
+from sim.sensor.readout import NoisePool, Readout
 from sim.sensor.spec import SensorSpec
 
 NOISE_STREAM = 0x53454E53  # the noise's random stream, apart from the run's others
@@ -27,6 +27,7 @@ class Sensor:
     def reset(self, seed: int) -> None:
         """A new run: the noise stream from the run's seed; exposure metered afresh."""
         self.rng = np.random.default_rng([int(seed) & 0xFFFFFFFF, NOISE_STREAM])
+        self._normals: NoisePool | None = None  # drawn on the first noisy frame
         self.exposure = AutoExposure(self.spec, self.dt, self.rate)
 
     @property
@@ -44,6 +45,10 @@ class Sensor:
     def read(self, light: np.ndarray, state: ExposureState) -> tuple[np.ndarray, ExposureState]:
         """The frame for `light` under `state`, and the state with the signal read; the
         auto-exposure learns from it for the next frame."""
-        image, signal = self.readout.read(light, self.rate, state.exposure_s, state.gain, self.rng)
+        if self._normals is None:
+            self._normals = NoisePool(self.rng)
+        image, signal = self.readout.read(
+            light, self.rate, state.exposure_s, state.gain, self._normals
+        )
         self.exposure.update(signal)
         return image, ExposureState(state.exposure_s, state.gain, state.subframes, signal)
