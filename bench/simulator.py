@@ -33,8 +33,22 @@ and with the people tracker (`tracker = "everyone"`), seconds per run and per fr
 sweep's dry run (sim.runs.estimate) takes its per-person cost from this line.
 `--people-runs-only` runs that part alone.
 
+And as a line of its own (benchmark `simulator_camera`), what a real camera's sensor
+(sim.sensor, sim.world.shutter) costs against the ideal camera (CameraSpec.sensor None):
+World.step with rendering at 768x432 on one core with IMX273 (auto exposure) beside the
+ideal camera, under the sun and overcast (1,000 lux: longer exposures), the two worlds
+stepped in turns frame by frame, p50 and p95 and their ratio against the goal (within
+CAMERA_GOAL_X), with the real camera's parts (linear light, readout, image motion); the
+readout and linear_light alone on a rendered frame's light; the sub-frame blur's cost on
+the car scale at FAST_SPEED with a fixed BLUR_EXPOSURE_MS exposure, its draws a frame
+and the frame time with the draws capped at each of BLUR_DRAWS; and the floor of a blur
+from a per-pixel motion field: a segmentation render and a depth read per frame, next to
+the render. `--camera-only` runs that part alone.
+
+The `--...-only` options choose parts (several may be given); with none, every part runs.
+
     .venv/bin/python -m bench.simulator [--frames 60] [--runs 6] [--people-only]
-        [--crowd-only] [--people-runs-only] [--no-append]
+        [--crowd-only] [--people-runs-only] [--camera-only] [--no-append]
 """
 
 from __future__ import annotations
@@ -71,6 +85,13 @@ PEOPLE_RUNS_TITLE = (
 RUN_PEOPLE = (1, 5, 10)
 TRACKER_NAMES = ("one", "everyone")  # sim.runs.run_spec.TRACKERS
 WARM_STEPS = 2  # steps of each world not timed (the new scene's first draws)
+CAMERA_TITLE = "Simulator: a real camera's frame (sensor, motion blur) against the ideal camera's"
+CAMERA_GOAL_X = 1.5  # the goal: the real camera's frame time within 1.5x the ideal camera's
+CAMERA_PARTS = ("render", "truth", "linear", "readout", "motion")
+FAST_SPEED = 13.9  # m/s (50 km/h): the car in town, where a long exposure smears most
+BLUR_EXPOSURE_MS = 30.0  # IMX273's longest exposure, fixed: the blur rows' long exposure
+BLUR_DRAWS = (1, 2, 4, 8)  # the sub-frame caps (SensorSpec.max_subframes) timed side by side
+READOUT_REPEATS = 40  # calls of the readout and of linear_light timed alone
 # The bystanders in the order they join (x, y, heading in degrees, speed in m/s), in the world
 # frame: the robot starts at the origin heading east (+x) at 2 m/s, the road is along x
 # with its edges at y = -3.5 and 3.5 and a 3 m pavement beyond each. Walkers in a row keep
@@ -108,20 +129,25 @@ def scenario(
     `shadows=False` is the overcast lighting (no shadow pass in the render); `model` the
     pedestrian's behaviour (a human walker's truth has a Track piece every 10 ms).
     """
-    from dataclasses import replace
-
     from monopic.cases import Case
     from sim.scenario.cases import CasePlacement
-    from sim.scenario.lighting import PRESETS
     from sim.scenario.walkers import WALKERS
 
     placement = CasePlacement(Case(case), duration=frames / REALTIME_FPS, seed=seed)
     sc = placement.scenario(behaviour=WALKERS[model]())
-    if shadows:
-        return sc
-    sun = sc.scene.lighting.sun  # the same sun behind clouds
-    overcast = PRESETS["overcast"].with_sun(sun.azimuth_deg, sun.elevation_deg)
-    return replace(sc, scene=replace(sc.scene, lighting=overcast))
+    return sc if shadows else overcast(sc)
+
+
+def overcast(sc: Any) -> Any:
+    """The scenario under the overcast preset: the same sun behind clouds (no shadow pass
+    in the render, and 1,000 lux instead of the clear sky's 32,000 for a real sensor)."""
+    from dataclasses import replace
+
+    from sim.scenario.lighting import PRESETS
+
+    sun = sc.scene.lighting.sun
+    cloudy = PRESETS["overcast"].with_sun(sun.azimuth_deg, sun.elevation_deg)
+    return replace(sc, scene=replace(sc.scene, lighting=cloudy))
 
 
 def crowd(people: int, frames: int, shadows: bool = True) -> Any:
@@ -141,19 +167,23 @@ def crowd(people: int, frames: int, shadows: bool = True) -> Any:
 
 
 class Stopwatch:
-    """Seconds spent in the calls of the functions it wraps, since the last `reset`."""
+    """Seconds spent in the calls of the functions it wraps, since the last `reset`, and
+    what the last of those calls returned (None if none returned since)."""
 
     def __init__(self) -> None:
         self.s = 0.0
+        self.last: Any = None
 
     def reset(self) -> None:
         self.s = 0.0
+        self.last = None
 
     def wrap(self, fn: Callable[..., Any]) -> Callable[..., Any]:
         def timed(*args: Any, **kwargs: Any) -> Any:
             t0 = time.perf_counter()
             try:
-                return fn(*args, **kwargs)
+                self.last = fn(*args, **kwargs)
+                return self.last
             finally:
                 self.s += time.perf_counter() - t0
 
@@ -172,13 +202,21 @@ def timed_parts() -> Iterator[dict[str, Stopwatch]]:
     from sim.world import world as world_module
     from sim.world.entities import pedestrian as pedestrian_module
 
-    watches = {part: Stopwatch() for part in PARTS}
-    targets = (
-        (world_module.World, "render", "render"),
-        (world_module.World, "_ground_truth", "truth"),
-        (pedestrian_module, "visibility", "visibility"),
-        (pedestrian_module, "occluded_landmarks", "landmark_rays"),
-    )
+    with timed(
+        (
+            (world_module.World, "render", "render"),
+            (world_module.World, "_ground_truth", "truth"),
+            (pedestrian_module, "visibility", "visibility"),
+            (pedestrian_module, "occluded_landmarks", "landmark_rays"),
+        )
+    ) as watches:
+        yield watches
+
+
+@contextmanager
+def timed(targets: Sequence[tuple[object, str, str]]) -> Iterator[dict[str, Stopwatch]]:
+    """A Stopwatch per part, each wrapped around its (owner, attribute) while inside."""
+    watches = {part: Stopwatch() for _, _, part in targets}
     with ExitStack() as stack:
         for owner, attr, part in targets:
             wrapped = watches[part].wrap(getattr(owner, attr))
@@ -422,6 +460,412 @@ def people_report(people: dict[str, Any], frames: int) -> tuple[dict[str, Any], 
     return results, "\n".join(lines)
 
 
+def with_sensor(sc: Any, sensor: Any) -> Any:
+    """The scenario with its robot's camera given `sensor` (None: the ideal camera)."""
+    from dataclasses import replace
+
+    camera = replace(sc.robot.camera, sensor=sensor)
+    return replace(sc, robot=replace(sc.robot, camera=camera))
+
+
+def fast_scenario(frames: int, sensor: Any = None) -> Any:
+    """The car scale (sim.scenario.families CAR: 1.8 m wide, camera 1.3 m up, 45 degrees
+    vertical) driving at FAST_SPEED under the overcast preset (where long exposures belong),
+    case 5's person crossing far enough ahead that the car never reaches the crossing
+    (nothing in the run stops it); `frames` frames at 15 fps."""
+    from monopic.cases import Case
+    from sim.scenario.cases import CasePlacement
+    from sim.scenario.families import CAR
+
+    duration = frames / REALTIME_FPS
+    placement = CasePlacement(
+        Case(5), distance=FAST_SPEED * duration / 2 + 15.0, robot_speed=FAST_SPEED,
+        duration=duration,
+    )  # fmt: skip
+    return with_sensor(overcast(placement.scenario(robot=CAR.robot)), sensor)
+
+
+def blur_sensor(most: int | None = None) -> Any:
+    """IMX273 with a fixed BLUR_EXPOSURE_MS exposure at gain 1; `most` caps the sub-frame
+    draws (None: the preset's max_subframes)."""
+    from dataclasses import replace
+
+    from sim.sensor.spec import IMX273
+
+    spec = replace(IMX273, exposure_ms=BLUR_EXPOSURE_MS, gain=1.0)
+    return spec if most is None else replace(spec, max_subframes=most)
+
+
+@contextmanager
+def camera_parts() -> Iterator[dict[str, Stopwatch]]:
+    """A Stopwatch per part of a real camera's World.step (CAMERA_PARTS): World.render (every
+    draw of the exposure), World._ground_truth, the shutter's linear_light (8-bit render to
+    linear light, once per draw), Sensor.read (noise, gain, digitiser, tone curve) and
+    Scene.image_motion (how many draws; its `last` is the image motion in pixels)."""
+    from sim.sensor.sensor import Sensor
+    from sim.world import shutter as shutter_module
+    from sim.world import world as world_module
+    from sim.world.scene import Scene
+
+    with timed(
+        (
+            (world_module.World, "render", "render"),
+            (world_module.World, "_ground_truth", "truth"),
+            (shutter_module, "linear_light", "linear"),
+            (Sensor, "read", "readout"),
+            (Scene, "image_motion", "motion"),
+        )
+    ) as watches:
+        yield watches
+
+
+CameraRecord = dict[str, list[float]]
+AfterStep = Callable[[str, Any], None]
+
+
+def step_in_turns(
+    specs: dict[str, Any],
+    frames: int,
+    watches: dict[str, Stopwatch],
+    out: dict[str, CameraRecord],
+    after: AfterStep | None = None,
+) -> None:
+    """World.step with rendering of each scenario in `specs`, the worlds stepped in turns
+    frame by frame (the first of each frame's turns rotating), so a busy spell of the host
+    hits every world alike; appends to `out[name]` each step's time and parts after the
+    first WARM_STEPS, then calls `after(name, world)` outside the timing.
+
+    Each world makes its own GL context: two renderers lent one context and drawn in turns
+    draw into each other's buffers (a frame of one world came back wrong by up to 240
+    levels), while a world alone in a kept context draws exactly what a world with its own
+    context draws.
+    """
+    from sim.world.world import World
+
+    with ExitStack() as stack:
+        worlds = {name: stack.enter_context(World(sc)) for name, sc in specs.items()}
+        dt = {name: sc.dt for name, sc in specs.items()}
+        for world in worlds.values():
+            world.reset()
+        names = list(worlds)
+        for k in range(frames - 1):  # as World.run: reset, then frames - 1 steps
+            first = k % len(names)
+            for name in names[first:] + names[:first]:
+                for watch in watches.values():
+                    watch.reset()
+                t0 = time.perf_counter()
+                step = worlds[name].step()
+                wall = time.perf_counter() - t0
+                if k < WARM_STEPS:
+                    continue
+                rec = out.setdefault(name, {})
+                rec.setdefault("step", []).append(1e3 * wall)
+                for part, watch in watches.items():
+                    rec.setdefault(part, []).append(1e3 * watch.s)
+                cam = step.truth.camera
+                if cam is not None:
+                    rec.setdefault("draws", []).append(cam.subframes)
+                    rec.setdefault("exposure", []).append(1e3 * cam.exposure_s)
+                    rec.setdefault("gain", []).append(cam.gain)
+                    motion = watches["motion"].last
+                    if motion is not None:  # image motion over the exposure, px
+                        share = min(cam.exposure_s / dt[name], 1.0)
+                        rec.setdefault("blur_px", []).append(motion * share)
+                if after is not None:
+                    after(name, worlds[name])
+
+
+def camera_summary(rec: CameraRecord) -> dict[str, Any]:
+    """One world's steps: p50 and p95 of the step, p50 of each part, the draws a frame and,
+    for a real camera, its exposure, gain and image motion over the exposure."""
+    import numpy as np
+
+    out: dict[str, Any] = {"frames": len(rec["step"])}
+    out["step_p50_ms"] = float(np.percentile(rec["step"], 50))
+    out["step_p95_ms"] = float(np.percentile(rec["step"], 95))
+    for part in CAMERA_PARTS:
+        out[f"{part}_p50_ms"] = float(np.percentile(rec[part], 50))
+    draws = rec.get("draws", [1])
+    out["draws_mean"] = float(np.mean(draws))
+    out["draws_min"], out["draws_max"] = int(min(draws)), int(max(draws))
+    for key, name in (("exposure", "exposure_p50_ms"), ("gain", "gain_p50"),
+                      ("blur_px", "blur_p50_px")):  # fmt: skip
+        out[name] = float(np.percentile(rec[key], 50)) if rec.get(key) else None
+    return out
+
+
+def child_camera(
+    frames: int,
+    rounds: int = 2,
+    draws: Sequence[int] = BLUR_DRAWS,
+    repeats: int = READOUT_REPEATS,
+) -> dict[str, Any]:
+    """The ideal camera against IMX273 (auto exposure) under the sun and overcast, with the
+    segmentation render timed on the ideal camera's sun frames; the sub-frame blur's cost
+    on the car scale with a fixed long exposure and the draws capped at each of `draws`;
+    the readout and linear_light alone on a rendered frame's light (`repeats` calls each).
+
+    Rounds alternate the order of the lightings; within a lighting the worlds step in
+    turns (step_in_turns).
+    """
+    import mujoco
+    import numpy as np
+
+    from sim.sensor.photometry import electrons_per_second
+    from sim.sensor.readout import Readout, linear_light
+    from sim.sensor.spec import IMX273
+
+    if frames <= WARM_STEPS + 1:
+        raise ValueError(f"frames must be more than {WARM_STEPS + 1}, got {frames}")
+    pairs: dict[str, dict[str, CameraRecord]] = {"sun": {}, "overcast": {}}
+    blur: dict[str, CameraRecord] = {}
+    seg: dict[str, list[float]] = {"masks": [], "depth_read": [], "render_again": []}
+    kept: dict[str, np.ndarray] = {}
+
+    def segmentation(name: str, world: Any) -> None:
+        """After an ideal sun step: the same state drawn again in colour, then its
+        segmentation render (every person's mask) and that draw's depth buffer read."""
+        if name != "ideal":
+            return
+        renderer = world.renderer
+        t0 = time.perf_counter()
+        kept["image"] = renderer.render()
+        t1 = time.perf_counter()
+        world.person_masks()
+        t2 = time.perf_counter()
+        depth = kept.setdefault(
+            "depth", np.empty((renderer.height, renderer.width), dtype=np.float32)
+        )
+        # SceneRenderer keeps its MuJoCo context to itself: its depth buffer is read here
+        # through its private fields, as a motion-field blur would have to read it.
+        renderer._context.make_current()
+        mujoco.mjr_readPixels(None, depth, renderer._rect, renderer._mjr)
+        t3 = time.perf_counter()
+        seg["render_again"].append(1e3 * (t1 - t0))
+        seg["masks"].append(1e3 * (t2 - t1))
+        seg["depth_read"].append(1e3 * (t3 - t2))
+
+    lux: dict[str, float] = {}
+    with camera_parts() as watches:
+        for r in range(rounds):
+            lights = ("sun", "overcast") if r % 2 == 0 else ("overcast", "sun")
+            for light in lights:
+                base = scenario(5, frames, shadows=light == "sun")
+                lux[light] = base.scene.lighting.illuminance_lux
+                specs = {"ideal": base, "real": with_sensor(base, IMX273)}
+                after = segmentation if light == "sun" else None
+                step_in_turns(specs, frames, watches, pairs[light], after)
+            specs = {"ideal": fast_scenario(frames), "auto": fast_scenario(frames, blur_sensor())}
+            specs |= {str(n): fast_scenario(frames, blur_sensor(n)) for n in draws}
+            step_in_turns(specs, frames, watches, blur)
+
+    # The readout on the light of a rendered sun frame, at the exposure IMX273 chose there.
+    sun = camera_summary(pairs["sun"]["real"])
+    image = kept["image"]
+    lit = linear_light(image)
+    readout = Readout(IMX273)
+    rate = electrons_per_second(IMX273, lux["sun"])
+    exposure_s, gain = sun["exposure_p50_ms"] / 1e3, sun["gain_p50"]
+    rng = np.random.default_rng(0)
+    read_ms, linear_ms = [], []
+    for _ in range(repeats):  # alternated, so both see the same host
+        t0 = time.perf_counter()
+        linear_light(image)
+        t1 = time.perf_counter()
+        readout.read(lit, rate, exposure_s, gain, rng)
+        t2 = time.perf_counter()
+        linear_ms.append(1e3 * (t1 - t0))
+        read_ms.append(1e3 * (t2 - t1))
+
+    res: dict[str, Any] = {"rounds": rounds, "lux": lux}
+    for light, worlds in pairs.items():
+        row = {name: camera_summary(rec) for name, rec in worlds.items()}
+        ratios = np.array(worlds["real"]["step"]) / np.array(worlds["ideal"]["step"])
+        row["paired_ratio_p50_x"] = float(np.percentile(ratios, 50))
+        res[light] = row
+    res["segmentation"] = {
+        f"{k}_{q}_ms": float(np.percentile(v, p)) for k, v in seg.items()
+        for q, p in (("p50", 50), ("p95", 95))
+    }  # fmt: skip
+    res["blur"] = {name: camera_summary(rec) for name, rec in blur.items()}
+    res["blur_exposure_ms"] = BLUR_EXPOSURE_MS
+    res["blur_speed_mps"] = FAST_SPEED
+    res["readout"] = {
+        "shape": list(lit.shape),
+        "repeats": repeats,
+        "exposure_ms": 1e3 * exposure_s,
+        "gain": gain,
+        "read_p50_ms": float(np.percentile(read_ms, 50)),
+        "read_p95_ms": float(np.percentile(read_ms, 95)),
+        "linear_light_p50_ms": float(np.percentile(linear_ms, 50)),
+        "linear_light_p95_ms": float(np.percentile(linear_ms, 95)),
+    }
+    res["maxrss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return res
+
+
+def camera_report(got: dict[str, Any], frames: int) -> tuple[dict[str, Any], str]:
+    """The camera child's figures as history results and a Markdown table."""
+    import numpy as np
+
+    timed_steps = frames - 1 - WARM_STEPS
+    lines = [
+        f"Scenario: bench/simulator.py `scenario(5)`, case 5 at 8 m (robot 2 m/s), 768x432; "
+        f"the ideal camera (CameraSpec.sensor None) against IMX273 (auto exposure); World.step "
+        f"with rendering on one core, the two worlds stepped in turns frame by frame (who goes "
+        f"first alternating, each world with its own GL context), {timed_steps} timed steps "
+        f"per world and round, {got['rounds']} round{'s' if got['rounds'] != 1 else ''}. "
+        "The real camera's parts: "
+        "sim.world.shutter.linear_light (once per draw), Sensor.read (noise, gain, digitiser, "
+        "tone curve) and Scene.image_motion (which sets the draws).",
+        "",
+        "| lighting | real: exposure p50, gain, draws | ideal p50 | ideal p95 | real p50 "
+        "| real p95 | real / ideal (p50s) | paired p50 | linear light | readout | image motion |",
+        "| --- | --- | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: | ---: |",
+    ]
+    results: dict[str, Any] = {"frames_per_world": frames, "rounds": got["rounds"],
+                               "goal_x": CAMERA_GOAL_X, "pairs": []}  # fmt: skip
+    verdicts = []
+    for light in ("sun", "overcast"):
+        ideal, real = got[light]["ideal"], got[light]["real"]
+        ratio = real["step_p50_ms"] / ideal["step_p50_ms"]
+        paired = got[light]["paired_ratio_p50_x"]
+        results["pairs"].append(
+            {
+                "lighting": light,
+                "illuminance_lux": got["lux"][light],
+                "frames": ideal["frames"],
+                "ideal_frame_p50_ms": ideal["step_p50_ms"],
+                "ideal_frame_p95_ms": ideal["step_p95_ms"],
+                "ideal_render_p50_ms": ideal["render_p50_ms"],
+                "real_frame_p50_ms": real["step_p50_ms"],
+                "real_frame_p95_ms": real["step_p95_ms"],
+                "real_render_p50_ms": real["render_p50_ms"],
+                "real_linear_light_p50_ms": real["linear_p50_ms"],
+                "real_readout_p50_ms": real["readout_p50_ms"],
+                "real_image_motion_p50_ms": real["motion_p50_ms"],
+                "real_exposure_p50_ms": real["exposure_p50_ms"],
+                "real_gain_p50": real["gain_p50"],
+                "real_blur_p50_px": real["blur_p50_px"],
+                "real_draws_mean": real["draws_mean"],
+                "real_draws_max": real["draws_max"],
+                "real_over_ideal_x": ratio,
+                "paired_ratio_p50_x": paired,
+            }
+        )
+        lines.append(
+            f"| {light}, {got['lux'][light]:,.0f} lux | {real['exposure_p50_ms']:.2f} ms, "
+            f"x{real['gain_p50']:.1f}, {real['draws_min']}-{real['draws_max']} "
+            f"| {ideal['step_p50_ms']:.1f} ms | {ideal['step_p95_ms']:.1f} ms "
+            f"| {real['step_p50_ms']:.1f} ms | {real['step_p95_ms']:.1f} ms | {ratio:.2f}x "
+            f"| {paired:.2f}x | {real['linear_p50_ms']:.1f} ms | {real['readout_p50_ms']:.1f} ms "
+            f"| {real['motion_p50_ms']:.2f} ms |"
+        )
+        verdicts.append(f"{light} {ratio:.2f}x ({'met' if ratio <= CAMERA_GOAL_X else 'not met'})")
+    lines += ["", f"The real camera within {CAMERA_GOAL_X:g}x the ideal's frame time: "
+              + "; ".join(verdicts) + "."]  # fmt: skip
+
+    ro = got["readout"]
+    results["readout"] = ro
+    h, w, c = ro["shape"]
+    lines += [
+        "",
+        f"Alone ({ro['repeats']} calls each, alternated): Readout.read on a {w}x{h}x{c} float32 "
+        f"light image (a sun frame's light, IMX273 at {ro['exposure_ms']:.2f} ms, "
+        f"x{ro['gain']:.1f}) p50 {ro['read_p50_ms']:.1f} ms (p95 {ro['read_p95_ms']:.1f}); "
+        f"linear_light (8-bit to float32 by lookup) p50 {ro['linear_light_p50_ms']:.1f} ms "
+        f"(p95 {ro['linear_light_p95_ms']:.1f}).",
+    ]
+
+    blur = got["blur"]
+    forced = sorted(int(k) for k in blur if k.isdigit())
+    ideal = blur["ideal"]
+    lines += [
+        "",
+        f"Motion blur by sub-frames: the car scale (sim.scenario.families CAR) at "
+        f"{got['blur_speed_mps']:g} m/s, overcast, IMX273 with a fixed "
+        f"{got['blur_exposure_ms']:g} ms exposure at gain 1 (bench/simulator.py fast_scenario, "
+        f"blur_sensor); the draws capped at each of {', '.join(map(str, forced))} beside the "
+        f"preset's cap (draws from the image motion); all stepped in turns. Image motion over "
+        f"the exposure p50 {blur['auto']['blur_p50_px']:.0f} px.",
+        "",
+        "| camera | draws a frame (mean; range) | frame p50 | frame p95 | render p50 "
+        "| vs ideal (p50s) |",
+        "| --- | ---: | ---: | ---: | ---: | ---: |",
+        f"| ideal | 1 | {ideal['step_p50_ms']:.1f} ms | {ideal['step_p95_ms']:.1f} ms "
+        f"| {ideal['render_p50_ms']:.1f} ms | 1.00x |",
+    ]
+    blur_rows = [{"camera": "ideal", "max_subframes": None, **_blur_row(ideal, ideal)}]
+    for key in [*map(str, forced), "auto"]:
+        row = blur[key]
+        cap = f"at most {key}" if key != "auto" else "the preset's cap"
+        blur_rows.append({"camera": key, "max_subframes": int(key) if key.isdigit() else None,
+                          **_blur_row(row, ideal)})  # fmt: skip
+        lines.append(
+            f"| {got['blur_exposure_ms']:g} ms, {cap} | {row['draws_mean']:.2f} "
+            f"({row['draws_min']}-{row['draws_max']}) | {row['step_p50_ms']:.1f} ms "
+            f"| {row['step_p95_ms']:.1f} ms | {row['render_p50_ms']:.1f} ms "
+            f"| {row['step_p50_ms'] / ideal['step_p50_ms']:.2f}x |"
+        )
+    results["blur"] = {"exposure_ms": got["blur_exposure_ms"], "speed_mps": got["blur_speed_mps"],
+                       "rows": blur_rows}  # fmt: skip
+    if len(forced) >= 2:
+        x = [blur[str(n)]["draws_mean"] for n in forced]
+        per_draw = float(np.polyfit(x, [blur[str(n)]["step_p50_ms"] for n in forced], 1)[0])
+        renders = [blur[str(n)]["render_p50_ms"] for n in forced]
+        render_per_draw = float(np.polyfit(x, renders, 1)[0])
+        results["blur"]["per_draw_ms"] = per_draw
+        results["blur"]["render_per_draw_ms"] = render_per_draw
+        lines += [
+            "",
+            f"Each draw beyond the first: {per_draw:.1f} ms a frame, of which the render "
+            f"{render_per_draw:.1f} ms (least-squares slopes over the capped rows).",
+        ]
+
+    sg = got["segmentation"]
+    sun_ideal = got["sun"]["ideal"]
+    floor = sg["masks_p50_ms"] + sg["depth_read_p50_ms"]
+    results["segmentation"] = sg | {
+        "step_render_p50_ms": sun_ideal["render_p50_ms"],
+        "floor_p50_ms": floor,
+        "floor_over_render_x": floor / sun_ideal["render_p50_ms"],
+    }
+    lines += [
+        "",
+        "The floor of a blur from a per-pixel motion field (MuJoCo gives none: a segmentation "
+        "render and a depth read every frame), on the ideal camera's sun frames, after each "
+        "timed step, of the same state:",
+        "",
+        "| per frame | p50 | p95 |",
+        "| --- | ---: | ---: |",
+        f"| colour render within World.step | {sun_ideal['render_p50_ms']:.1f} ms | |",
+        f"| the same state drawn again in colour (SceneRenderer.render) "
+        f"| {sg['render_again_p50_ms']:.1f} ms | {sg['render_again_p95_ms']:.1f} ms |",
+        f"| segmentation render (World.person_masks) | {sg['masks_p50_ms']:.1f} ms "
+        f"| {sg['masks_p95_ms']:.1f} ms |",
+        f"| depth read of that draw (mjr_readPixels) | {sg['depth_read_p50_ms']:.1f} ms "
+        f"| {sg['depth_read_p95_ms']:.1f} ms |",
+        "",
+        f"Segmentation and depth: {floor:.1f} ms a frame, "
+        f"{floor / sun_ideal['render_p50_ms']:.2f}x the colour render, whatever moves.",
+    ]
+    results["peak_rss_mb"] = got["maxrss_mb"]
+    return results, "\n".join(lines)
+
+
+def _blur_row(row: dict[str, Any], ideal: dict[str, Any]) -> dict[str, Any]:
+    return {
+        "draws_mean": row["draws_mean"],
+        "draws_min": row["draws_min"],
+        "draws_max": row["draws_max"],
+        "frame_p50_ms": row["step_p50_ms"],
+        "frame_p95_ms": row["step_p95_ms"],
+        "render_p50_ms": row["render_p50_ms"],
+        "blur_p50_px": row["blur_p50_px"],
+        "vs_ideal_x": row["step_p50_ms"] / ideal["step_p50_ms"],
+    }
+
+
 def child_render(frames: int) -> dict[str, Any]:
     """World.step with and without rendering, one core; first frame (GL setup) excluded."""
     import numpy as np
@@ -616,8 +1060,13 @@ def main() -> None:
         help="only a sweep run's time with 1, 5 and 10 people (its own history line)",
     )  # fmt: skip
     ap.add_argument(
+        "--camera-only", action="store_true",
+        help="only a real camera's frame (sensor, motion blur) against the ideal camera's "
+        "(its own history line)",
+    )  # fmt: skip
+    ap.add_argument(
         "--child",
-        choices=("render", "run", "sweep", "people", "crowd", "people_runs"),
+        choices=("render", "run", "sweep", "people", "crowd", "people_runs", "camera"),
         help=argparse.SUPPRESS,
     )
     ap.add_argument("--people", type=int, nargs="+", default=PEOPLE, help=argparse.SUPPRESS)
@@ -640,6 +1089,8 @@ def main() -> None:
             out = child_crowd(args.frames)
         elif args.child == "people_runs":
             out = child_people_runs(args.frames, args.people, args.rounds)
+        elif args.child == "camera":
+            out = child_camera(args.frames, args.rounds)
         elif args.child == "run":
             out = child_run(
                 args.frames, bool(args.ablation), bool(args.shadows), args.model, args.runtime
@@ -649,7 +1100,8 @@ def main() -> None:
         print(json.dumps(out))
         return
 
-    if args.people_runs_only or not (args.people_only or args.crowd_only):
+    parts = chosen_parts(args)
+    if "people_runs" in parts:
         recorder = Recorder("simulator_people_runs", PEOPLE_RUNS_TITLE)
         counts = [n for n in args.people if n in RUN_PEOPLE] or list(RUN_PEOPLE)
         got = spawn_child("people_runs", True, frames=args.frames, rounds=args.rounds,
@@ -657,22 +1109,35 @@ def main() -> None:
         results, table = people_runs_report(got, args.frames)
         print(table)
         recorder.finish(results, table, write=not args.no_append)
-        if args.people_runs_only:
-            return
-    if not (args.people_only or args.crowd_only):
+    if "main" in parts:
         main_rows(args)
-    if not args.people_only:
+    if "crowd" in parts:
         recorder = Recorder("simulator_crowd", CROWD_TITLE)
         results, table = crowd_report(spawn_child("crowd", True, frames=args.frames), args.frames)
         print(table)
         recorder.finish(results, table, write=not args.no_append)
-    if args.crowd_only:
-        return
-    recorder = Recorder("simulator_people", PEOPLE_TITLE)
-    people = spawn_child("people", True, frames=args.frames)
-    results, table = people_report(people, args.frames)
-    print(table)
-    recorder.finish(results, table, write=not args.no_append)
+    if "people" in parts:
+        recorder = Recorder("simulator_people", PEOPLE_TITLE)
+        people = spawn_child("people", True, frames=args.frames)
+        results, table = people_report(people, args.frames)
+        print(table)
+        recorder.finish(results, table, write=not args.no_append)
+    if "camera" in parts:
+        recorder = Recorder("simulator_camera", CAMERA_TITLE)
+        got = spawn_child("camera", True, frames=args.frames, rounds=args.rounds)
+        results, table = camera_report(got, args.frames)
+        print(table)
+        recorder.finish(results, table, write=not args.no_append)
+
+
+ONLY = ("people_runs", "crowd", "people", "camera")  # the parts an `--X-only` option names
+
+
+def chosen_parts(args: argparse.Namespace) -> set[str]:
+    """The parts to run: those the `--X-only` options name, or every part (the render,
+    whole-run and sweep rows, `main`, among them) when none is given."""
+    named = {part for part in ONLY if getattr(args, f"{part}_only")}
+    return named or {"main", *ONLY}
 
 
 def main_rows(args: argparse.Namespace) -> None:
