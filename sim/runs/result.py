@@ -21,6 +21,8 @@ Growing it (one rule for every growth: the lighting, several people, the camera)
   and the decision behind it (with the one-pedestrian tracker: its one person's; with
   the people tracker, `tracker` = "everyone": each predictor's worst person's, whose
   identity is in `tracks`).
+- The camera: `camera` names a real camera's sensor preset (sim.sensor.spec); lines of
+  the ideal camera, as every line before the camera model, leave it out.
 - SCHEMA goes up when a field is renamed, removed or changes meaning or units: lines of
   another schema are then refused with one line saying how to redo them, never read as
   if they meant the new thing.
@@ -217,6 +219,9 @@ class RunResult:
     # person, so every warning can be matched to a person.
     tracker: str = ""
     tracks: dict[str, TrackColumns] = field(default_factory=dict)
+    # Runs with a real camera (OPTIONAL): its sensor's preset name ("" on the ideal
+    # camera's lines, the renderer's frames as they are, as every line before it).
+    camera: str = ""
 
     # JSON key order of a line (the fields above in the order lines have always had).
     ORDER = (
@@ -225,7 +230,7 @@ class RunResult:
     )  # fmt: skip
 
     # Keys written only on the lines of runs that have them (see "Growing it").
-    OPTIONAL = ("people", "first_threat", "tracker", "tracks")
+    OPTIONAL = ("people", "first_threat", "tracker", "tracks", "camera")
 
     def to_json(self) -> dict[str, Any]:
         """The line as JSON-ready data (plain dicts and lists)."""
@@ -235,6 +240,8 @@ class RunResult:
             line.update({k: plain[k] for k in ("people", "first_threat")})
         if self.tracker:
             line.update({k: plain[k] for k in ("tracker", "tracks")})
+        if self.camera:
+            line["camera"] = self.camera
         return line
 
     def deterministic(self) -> dict[str, Any]:

@@ -171,6 +171,7 @@ def run(
         pipelines={name: r.finished() for name, r in recorders.items()},
         tracker=EVERYONE if everyone else "",
         tracks={n: r.tracks for n, r in recorders.items() if r.tracks is not None},
+        camera=_camera_of(scenario),
         timing=Timing(
             wall_s=round(time.perf_counter() - start, 3),
             sim_ms=[round(v, 2) for v in times.ms],
@@ -178,6 +179,12 @@ def run(
             machine=machine(),
         ),
     )
+
+
+def _camera_of(scenario: Scenario) -> str:
+    """The line's `camera`: a real camera's sensor preset, "" for the ideal camera."""
+    sensor = scenario.robot.camera.sensor
+    return "" if sensor is None else sensor.name
 
 
 def _start_recording(spec: RunSpec, world: World):

@@ -101,6 +101,7 @@ def every_field_set() -> RunResult:
                 warned_for={"rules/image": [None, None, 1]},
             )
         },
+        camera="imx273",
     )
 
 
@@ -128,7 +129,9 @@ def test_a_written_line_reads_back_with_every_field_equal(tmp_path: Path) -> Non
 def test_lines_keep_their_key_order_and_deterministic_drops_only_timing() -> None:
     record = every_field_set()
     assert list(record.to_json()) == [*RunResult.ORDER, *RunResult.OPTIONAL]
-    one = dataclasses.replace(record, tracker="", tracks={})  # the one-pedestrian tracker
+    ideal = dataclasses.replace(record, camera="")  # the ideal camera: no `camera`
+    assert list(ideal.to_json()) == [*RunResult.ORDER, *RunResult.OPTIONAL[:-1]]
+    one = dataclasses.replace(ideal, tracker="", tracks={})  # the one-pedestrian tracker
     assert list(one.to_json()) == [*RunResult.ORDER, "people", "first_threat"]
     alone = dataclasses.replace(one, people=[], first_threat=None)  # one person
     assert list(alone.to_json()) == list(RunResult.ORDER)
