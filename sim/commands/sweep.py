@@ -173,6 +173,8 @@ def dry_run(spec: SweepSpec, out: Path, args: argparse.Namespace) -> None:
           f"{out}, {len(todo)} to run{limit}")  # fmt: skip
     if spec.intent_tree is not None:
         print(f"  also predictor intent-tree/ground with {spec.intent_tree}")
+    if spec.camera is not None:
+        print(f"  every run with the {spec.camera} camera (the spec's `camera`)")
     width = max(len("family"), *(len(f) for f in families))
     scales = {f: "/".join(sorted({r.scale for r in m})) for f, m in families.items()}
     scale_width = max(len("scale"), *(len(v) for v in scales.values()))

@@ -11,6 +11,7 @@ from monopic.cases import Case
 from sim.dataset.spec import JPEG_QUALITY, DatasetSpec
 from sim.runs.sweep import Include, SweepSpec
 from sim.scenario.files import Values
+from sim.sensor.spec import IDEAL
 
 
 def readme(spec: DatasetSpec, counts: dict[str, Any]) -> str:
@@ -137,6 +138,15 @@ Runs per family: {families}.
 Each run lasts as its scenario file says (a run stops at contact), with that file's
 frame rate, horizon, camera, road, lighting and pedestrian; the pipeline is the paper's
 image mode (rule cascade) on one onnxruntime thread."""
+    if sweep.camera is not None:
+        how = (
+            "the renderer's frames as they are" if sweep.camera == IDEAL
+            else "the rendered light through its sensor: exposure, motion blur, noise, digitiser"
+        )  # fmt: skip
+        runs += f"""
+
+Every run's camera is the spec's `camera`, {sweep.camera} ({how}), whatever its
+scenario file names; the run ids and seeds are those of the files' own scenarios."""
     return what, image_format, runs
 
 

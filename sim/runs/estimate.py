@@ -24,6 +24,11 @@ their landmarks every frame. The per-person figures come from the benchmark's
 `simulator_people_runs` line (whole runs with 1, 5 and 10 people under each tracker);
 finished runs then scale every run's benchmark cost by how much slower or faster this
 machine ran theirs, so a sweep mixing one person and ten is estimated run by run.
+
+The camera's sensor (sim.sensor) is not in the benchmark's figure: a real camera renders
+several sub-frames per frame for its motion blur (sim.world.shutter), so before its first
+run finishes a real camera's sweep or dataset is estimated as if its camera were ideal,
+too short; the measured figure of its finished runs (their wall times) includes it.
 """
 
 from __future__ import annotations

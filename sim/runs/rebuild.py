@@ -2,8 +2,9 @@
 
 A sweep's result line records what made its run: the scenario file (`file`, as the sweep
 found it from the folder it ran in), the swept values (`params`), the world seed (`seed`),
-the code (`code`, with the intent tree's digest when the sweep ran one) and, by its
-pipelines, whether the ablation ran. That is all the run needs. Rebuilding the scenario
+the code (`code`, with the intent tree's digest when the sweep ran one and the camera
+when its spec named one, sim.runs.sweep.sweep_code) and, by its pipelines, whether the
+ablation ran. That is all the run needs. Rebuilding the scenario
 from the file with those values gives the run's digest back (the last part of its id)
 unless the file has changed since, and the run loop gives the same frames and decisions
 for the same scenario and code, so the line of the run done again equals the stored one,
@@ -30,7 +31,15 @@ from monopic.errors import UserError
 from sim.runs.result import ABLATION, RunResult, values_said
 from sim.runs.results_file import read_rows
 from sim.runs.run_spec import ONE, TRACKERS, RunSpec
-from sim.runs.sweep import PEOPLE_TAG, TREE_TAG, run_scenario, tree_digest
+from sim.runs.sweep import (
+    CAMERA_TAG,
+    PEOPLE_TAG,
+    TREE_TAG,
+    camera_of_code,
+    run_scenario,
+    tree_digest,
+    with_camera,
+)
 from sim.scenario.files import ScenarioFile, load
 from sim.scenario.spec import Scenario
 
@@ -105,12 +114,12 @@ def find_line(results: Path, run_id: str) -> dict[str, Any]:
 
 
 def code_of(row: dict[str, Any]) -> str | None:
-    """The code version that ran a line, without the intent tree's digest or the people
-    tracker's tag."""
+    """The code version that ran a line, without the intent tree's digest, the camera's
+    tag or the people tracker's tag (sim.runs.sweep.sweep_code)."""
     code = row.get("code")
     if not isinstance(code, str) or not code:
         return None
-    return code.partition(TREE_TAG)[0].removesuffix(PEOPLE_TAG)
+    return code.partition(TREE_TAG)[0].partition(CAMERA_TAG)[0].removesuffix(PEOPLE_TAG)
 
 
 # -- sweep lines ------------------------------------------------------------------------
@@ -190,9 +199,13 @@ def rebuild(row: RunResult, asked: Asked) -> RunSpec:
     """The RunSpec of a sweep's line, recording into `asked.out`; UserError (one line) when
     the scenario file is missing or no longer gives the run (it changed since the sweep)."""
     scenario_file, probe = scenario_file_of(row, asked.results, asked.anyway)
+    scenario = replace(probe, name=row.id, seed=row.seed)
+    camera = camera_of_code(row.code)
+    if camera is not None:  # the sweep's spec named the camera: its tag in the line's code
+        scenario = with_camera(scenario, camera, asked.results)
     return RunSpec(
         id=row.id,
-        scenario=replace(probe, name=row.id, seed=row.seed),
+        scenario=scenario,
         family=scenario_file.family,
         file=row.file,
         kind=scenario_file.kind,

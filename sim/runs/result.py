@@ -21,6 +21,8 @@ Growing it (one rule for every growth: the lighting, several people, the camera)
   and the decision behind it (with the one-pedestrian tracker: its one person's; with
   the people tracker, `tracker` = "everyone": each predictor's worst person's, whose
   identity is in `tracks`).
+- The camera: `camera` names a real camera's sensor preset (sim.sensor.spec); lines of
+  the ideal camera, as every line before the camera model, leave it out.
 - A real camera (sim.sensor): `exposure` holds each frame's exposure time, gain, sub-frame
   draws and mean signal; ideal-camera lines have none.
 - SCHEMA goes up when a field is renamed, removed or changes meaning or units: lines of
@@ -229,6 +231,9 @@ class RunResult:
     # person, so every warning can be matched to a person.
     tracker: str = ""
     tracks: dict[str, TrackColumns] = field(default_factory=dict)
+    # Runs with a real camera (OPTIONAL): its sensor's preset name ("" on the ideal
+    # camera's lines, the renderer's frames as they are, as every line before it).
+    camera: str = ""
     # Runs under a real camera only (OPTIONAL): the exposure of every frame.
     exposure: ExposureColumns | None = None
 
@@ -239,7 +244,7 @@ class RunResult:
     )  # fmt: skip
 
     # Keys written only on the lines of runs that have them (see "Growing it").
-    OPTIONAL = ("people", "first_threat", "tracker", "tracks", "exposure")
+    OPTIONAL = ("people", "first_threat", "tracker", "tracks", "camera", "exposure")
 
     def to_json(self) -> dict[str, Any]:
         """The line as JSON-ready data (plain dicts and lists)."""
@@ -249,6 +254,8 @@ class RunResult:
             line.update({k: plain[k] for k in ("people", "first_threat")})
         if self.tracker:
             line.update({k: plain[k] for k in ("tracker", "tracks")})
+        if self.camera:
+            line["camera"] = self.camera
         if self.exposure is not None:
             line["exposure"] = plain["exposure"]
         return line

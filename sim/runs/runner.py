@@ -171,6 +171,7 @@ def run(
         pipelines={name: r.finished() for name, r in recorders.items()},
         tracker=EVERYONE if everyone else "",
         tracks={n: r.tracks for n, r in recorders.items() if r.tracks is not None},
+        camera=_camera_of(scenario),
         exposure=truth.exposure,
         timing=Timing(
             wall_s=round(time.perf_counter() - start, 3),
@@ -179,6 +180,12 @@ def run(
             machine=machine(),
         ),
     )
+
+
+def _camera_of(scenario: Scenario) -> str:
+    """The line's `camera`: a real camera's sensor preset, "" for the ideal camera."""
+    sensor = scenario.robot.camera.sensor
+    return "" if sensor is None else sensor.name
 
 
 def _start_recording(spec: RunSpec, world: World):

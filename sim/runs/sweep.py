@@ -6,6 +6,7 @@ A sweep spec (scenarios/sweeps/*.toml, documented in scenarios/README.md):
     ablation = true                 # also run the ground-truth-crop pipeline
     licence = "CC-BY-4.0"           # only for `monopic dataset` (a sweep ignores it)
     intent_tree = "../trees/ground.json"  # optional: also run predictor intent-tree/ground
+    camera = "imx273"               # optional: every run's camera sensor (default: the file's)
     [[include]]
     files = ["../families/car/*.toml"]   # globs, relative to the spec
     sampling = "random"             # "file" (as each file says), "base", "grid", "random"
@@ -18,6 +19,11 @@ A sweep spec (scenarios/sweeps/*.toml, documented in scenarios/README.md):
 Expansion is deterministic: a run's id is the file's name, its draw number and a digest
 of the complete scenario, and its seed derives from the same, so re-expanding the spec
 finds the same runs (resume) and any executor produces the same results.
+
+A spec's `camera` (a sensor preset, sim.sensor.spec.PRESETS) is put into each run's
+scenario after its id and seed are made from the file's own scenario: the same sweep under
+two cameras has the same runs, paired by id. Its results are kept apart by the code
+version (CAMERA_TAG), and `monopic rerun` reads the camera back from there.
 """
 
 from __future__ import annotations
@@ -58,10 +64,14 @@ from sim.scenario.files import (
     unsweepable,
 )
 from sim.scenario.spec import Scenario, scenario_text
-from sim.scenario.toml_table import TomlTable, read_toml
+from sim.scenario.toml_table import FieldError, TomlTable, read_toml
+from sim.sensor.spec import PRESETS as CAMERAS
+from sim.sensor.spec import SensorSpecError, preset
 
 INCLUDE_SAMPLING = ("file", "base", "grid", "random")
-SPEC_KEYS = ("name", "description", "ablation", "licence", "intent_tree", "tracker", "include")
+SPEC_KEYS = (
+    "name", "description", "ablation", "licence", "intent_tree", "tracker", "camera", "include",
+)  # fmt: skip
 
 
 @dataclass(frozen=True)
@@ -93,6 +103,9 @@ class SweepSpec:
     # Whom the pipeline follows (sim.runs.run_spec.TRACKERS): "one" pedestrian, as every
     # sweep before the people tracker, or "everyone" in view, judged person by person.
     tracker: str = ONE
+    # The camera's sensor preset every run has (sim.sensor.spec.PRESETS); None: each
+    # scenario file's own camera, as every sweep before the camera model.
+    camera: str | None = None
 
 
 def load_spec(path: Path | str) -> SweepSpec:
@@ -118,6 +131,7 @@ def parse_spec(
     licence = top.text("licence", None, nonempty=True)
     intent_tree = _intent_tree(top, path)
     tracker = top.text("tracker", ONE, TRACKERS)
+    camera = top.text("camera", None, tuple(CAMERAS))
     includes = []
     for entry in top.tables("include"):
         patterns = entry.raw("files")
@@ -155,7 +169,7 @@ def parse_spec(
     if not includes:
         raise ScenarioFileError(path, "include", [], "a sweep needs at least one [[include]]")
     return SweepSpec(
-        path, name, description, ablation, tuple(includes), licence, intent_tree, tracker
+        path, name, description, ablation, tuple(includes), licence, intent_tree, tracker, camera
     )
 
 
@@ -299,10 +313,13 @@ def expand_spec(spec: SweepSpec) -> list[RunSpec]:
                 seen.add(rid)
                 drawn.add((digest, built.seed))
                 seed = run_seed(file, digest, built.seed)
+                scenario = replace(probe, name=rid, seed=seed)
+                if spec.camera is not None:  # after the id and seed: the file's own runs
+                    scenario = with_camera(scenario, spec.camera, spec.path)
                 runs.append(
                     RunSpec(
                         id=rid,
-                        scenario=replace(probe, name=rid, seed=seed),
+                        scenario=scenario,
                         family=file.family,
                         file=str(path),
                         kind=file.kind,
@@ -315,6 +332,16 @@ def expand_spec(spec: SweepSpec) -> list[RunSpec]:
                     )
                 )
     return runs
+
+
+def with_camera(scenario: Scenario, name: str, spec: Path) -> Scenario:
+    """The scenario with the camera sensor preset `name` (the spec's `camera`); a camera
+    that cannot keep the scenario's frame rate is refused naming the spec's field."""
+    try:
+        camera = replace(scenario.robot.camera, sensor=preset(name))
+        return replace(scenario, robot=replace(scenario.robot, camera=camera))
+    except SensorSpecError as err:
+        raise FieldError(spec, "camera", name, f"run {scenario.name}: {err}") from None
 
 
 def _plain(value: Any) -> Any:
@@ -461,11 +488,15 @@ def sweep_code(spec: SweepSpec) -> str:
     """The code version its results carry: with an intent tree, the tree file's digest too.
 
     So a results file made with one tree is not resumed with another (it is "other code"),
-    nor one made with the one-pedestrian tracker with the people tracker (PEOPLE_TAG).
+    nor one made with the one-pedestrian tracker with the people tracker (PEOPLE_TAG), nor
+    one of each file's own camera with a camera the spec names, or one camera with another
+    (CAMERA_TAG: any `camera` key, "ideal" too, since a file may name a real camera).
     """
     code = code_version()
     if spec.tracker == EVERYONE:
         code += PEOPLE_TAG
+    if spec.camera is not None:
+        code += f"{CAMERA_TAG}{spec.camera}"
     if spec.intent_tree is None:
         return code
     return f"{code}{TREE_TAG}{tree_digest(spec.intent_tree)}"
@@ -473,6 +504,13 @@ def sweep_code(spec: SweepSpec) -> str:
 
 TREE_TAG = "+tree-"  # joins the code version and the intent tree's digest (sweep_code)
 PEOPLE_TAG = "+everyone"  # follows the code version of a sweep with the people tracker
+CAMERA_TAG = "+camera-"  # then the camera preset of a sweep whose spec names one
+
+
+def camera_of_code(code: str | None) -> str | None:
+    """The camera preset a sweep's spec named, from its lines' code (None: none named)."""
+    camera = (code or "").partition(TREE_TAG)[0].partition(CAMERA_TAG)[2]
+    return camera or None
 
 
 def tree_digest(path: Path) -> str:

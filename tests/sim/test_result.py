@@ -12,6 +12,7 @@ from sim.runs.result import (
     SCHEMA,
     CameraSummary,
     DecisionColumns,
+    ExposureColumns,
     Machine,
     PersonColumns,
     PipelineColumns,
@@ -101,6 +102,13 @@ def every_field_set() -> RunResult:
                 warned_for={"rules/image": [None, None, 1]},
             )
         },
+        camera="imx273",
+        exposure=ExposureColumns(
+            exposure_ms=[0.22, 0.23, None],
+            gain=[1.0, 1.5, None],
+            subframes=[1, 3, 1],
+            signal=[0.18, None, 0.2],
+        ),  # fmt: skip
     )
 
 
@@ -128,7 +136,9 @@ def test_a_written_line_reads_back_with_every_field_equal(tmp_path: Path) -> Non
 def test_lines_keep_their_key_order_and_deterministic_drops_only_timing() -> None:
     record = every_field_set()
     assert list(record.to_json()) == [*RunResult.ORDER, *RunResult.OPTIONAL]
-    one = dataclasses.replace(record, tracker="", tracks={})  # the one-pedestrian tracker
+    ideal = dataclasses.replace(record, camera="", exposure=None)  # no `camera`, `exposure`
+    assert list(ideal.to_json()) == [*RunResult.ORDER, *RunResult.OPTIONAL[:-2]]
+    one = dataclasses.replace(ideal, tracker="", tracks={})  # the one-pedestrian tracker
     assert list(one.to_json()) == [*RunResult.ORDER, "people", "first_threat"]
     alone = dataclasses.replace(one, people=[], first_threat=None)  # one person
     assert list(alone.to_json()) == list(RunResult.ORDER)
