@@ -173,6 +173,9 @@ class SceneRenderer(Closing):
         if self._mjr is None:
             raise RuntimeError("render called after close")
         self._context.make_current()
+        # Bind this renderer's own offscreen buffer: another renderer sharing the context
+        # may have drawn since, and would otherwise receive this draw.
+        mujoco.mjr_setBuffer(mujoco.mjtFramebuffer.mjFB_OFFSCREEN, self._mjr)
         mujoco.mjv_updateScene(
             self.scene.model,
             self.scene.data,

@@ -454,3 +454,25 @@ def test_the_case_placement_checks_the_same_range_at_every_entry_point(tmp_path,
     with pytest.raises(ScenarioFileError, match=r"case.toml: path.distance = -3.0: must be >= 0"):
         load(scenario)
     assert not (tmp_path / "x.rrd").exists()
+
+
+def test_two_worlds_drawing_in_turns_in_one_context_draw_what_each_draws_alone() -> None:
+    """Each renderer binds its own offscreen buffer before it draws (sim.world.render)."""
+    from monopic.cases import Case
+    from sim.scenario.cases import CasePlacement
+    from sim.world.render import RenderContext
+
+    a = CasePlacement(Case(5), duration=0.2, seed=1).scenario()
+    b = CasePlacement(Case(3), duration=0.2, seed=2).scenario()
+    alone = {}
+    for name, s in (("a", a), ("b", b)):
+        with World(s) as w:
+            alone[name] = [step.frame.image for step in w.run()]
+    context = RenderContext(768, 432)
+    try:
+        with World(a, render_context=context) as wa, World(b, render_context=context) as wb:
+            for k, (sa, sb) in enumerate(zip(wa.run(), wb.run(), strict=True)):
+                assert np.array_equal(sa.frame.image, alone["a"][k])
+                assert np.array_equal(sb.frame.image, alone["b"][k])
+    finally:
+        context.close()
