@@ -443,6 +443,7 @@ def render(
     beside: Beside | None = None,
 ) -> str:
     """DIR/report.md: the calculator's points first, then how they came about."""
+    claimed = {protocol.tests[t].load_case.split(" ")[0] for t in tests}
     grid_runs = sum(r["role"] == GRID for r in rows)
     verify_runs = sum(r["role"] == VERIFY for r in rows)
     nm_runs = sum(r["role"] == NEAR_MISS for r in rows)
@@ -474,9 +475,9 @@ def render(
         "Per load case: standard + extended + robustness points of the calculator's Scenario "
         "Scores over their maximum (day and night together: the night half is not run).",
         "",
-        score_table(scores, {protocol.tests[t].load_case.split(" ")[0] for t in tests}),
+        score_table(scores, claimed),
         "",
-        *_beside_lines(beside, {protocol.tests[t].load_case.split(" ")[0] for t in tests}),
+        *_beside_lines(beside, claimed),
         f"Left unscored: {left_unscored}.",
         "",
     ]

@@ -19,7 +19,7 @@ from sim.scenario import presets
 from sim.scenario.lighting import DAY, PRESETS, Lighting
 from sim.scenario.plan import Anchor, Leg
 from sim.scenario.walkers import HumanWalker, RailWalker, Walker
-from sim.sensor.spec import IDEAL, SensorSpec
+from sim.sensor.spec import SensorSpec
 
 RGB = tuple[float, float, float]
 
@@ -130,10 +130,6 @@ class CameraSpec:
     # The image sensor behind the lens (sim.sensor): None is the `ideal` camera, the
     # renderer's frames as they are; a preset's figures otherwise.
     sensor: SensorSpec | None = None
-
-    @property
-    def sensor_name(self) -> str:
-        return IDEAL if self.sensor is None else self.sensor.name
 
     def model(self) -> CameraModel:
         return CameraModel.from_fov(

@@ -30,34 +30,15 @@ from sim.runs.sweep import (
 from sim.scenario.toml_table import FieldError
 from sim.sensor import spec as sensor_spec
 from sim.sensor.spec import IMX273
+from tests.sim.test_sweep import SCENARIO as TINY
 
-# Three 6-frame crossings on a 256x144 camera (a grid over the robot's speed).
-SCENARIO = """
-name = "tiny"
-kind = "collision"
-scale = "small"
-duration = 0.4
-fps = 15
-[robot]
-speed = 2.0
-[robot.camera]
-width = 256
-height = 144
-{sensor}
-[pedestrian]
-speed = 1.4
-[path]
-kind = "case"
-case = 5
-distance = 3.0
-[scene.road]
-buildings = false
-crosswalk = false
-[sweep]
-sampling = "grid"
-[sweep.parameters]
-"robot.speed" = [0.0, 1.0, 2.0]
-"""
+
+# test_sweep's three 6-frame crossings on a 256x144 camera, the sensor's lines (if any)
+# in its [robot.camera].
+def scenario_text(sensor: str) -> str:
+    return TINY.replace("height = 144\n", f"height = 144\n{sensor}\n", 1)
+
+
 SPEC = """
 name = "tiny"
 {camera}
@@ -68,7 +49,7 @@ files = ["tiny.toml"]
 
 def spec_file(folder: Path, camera: str | None, sensor: str = "") -> Path:
     """A spec of the tiny file (whose [robot.camera] adds `sensor`) with that `camera`."""
-    (folder / "tiny.toml").write_text(SCENARIO.format(sensor=sensor))
+    (folder / "tiny.toml").write_text(scenario_text(sensor))
     path = folder / f"spec-{camera}.toml"
     path.write_text(SPEC.format(camera="" if camera is None else f'camera = "{camera}"'))
     return path
