@@ -3,8 +3,10 @@
 A Lighting is the sky's light from everywhere (MuJoCo's headlight: ambient and diffuse
 from the camera) and the sun, a directional light with its direction, colours and whether
 it casts shadows. Overcast is the same sun behind clouds: weak, shadowless, with more
-light from the sky. Night (lamps and headlamps as bodies of their own) is one more preset
-whose lights are entities (sim.world.entities); nothing else needs to change.
+light from the sky. Night is one more preset: 1 lux from everywhere (the Euro NCAP night
+tests' ambient), a black sky, the moon left out (the protocol catalogue's night moon gives
+0.1 lux, a tenth of the ambient), and the light that matters from lamps and headlamps
+(sim.scenario.lamps), which a night scene must have: the car's low beams at least.
 
 `name` is the preset the lighting came from; results record it (sim.runs.result) and a
 report can group by it. A file that moves the sun (`sun_azimuth_deg`, `sun_elevation_deg`)
@@ -12,7 +14,9 @@ keeps its preset's name and records the angles it used in the scenario.
 
 Illuminance (for a real camera's sensor, sim.sensor): a clear sky's 32,000 lux is the low
 end of direct sunlight and an overcast sky's 1,000 lux the usual figure for an overcast day
-(the illuminance tables of the lux's definition, e.g. Wikipedia's "Lux").
+(the illuminance tables of the lux's definition, e.g. Wikipedia's "Lux"). At night the
+render is photometric: its white stands for NIGHT_FULL_SCALE_LUX and every light's value
+is its illuminance over that (sim.world.lighting).
 """
 
 from __future__ import annotations
@@ -34,6 +38,11 @@ class Sun:
     ambient: RGB = (0.12, 0.12, 0.13)
     specular: RGB = (0.15, 0.15, 0.15)
 
+    @property
+    def shines(self) -> bool:
+        """Whether it gives any light (a light that gives none takes no renderer slot)."""
+        return any(v > 0 for v in (*self.diffuse, *self.ambient, *self.specular))
+
 
 @dataclass(frozen=True)
 class Lighting:
@@ -46,6 +55,15 @@ class Lighting:
     # What the render's white stands for: the illuminance on a white surface drawn at full
     # brightness (sim.sensor.photometry). Only a real camera's sensor reads it.
     illuminance_lux: float = 32000.0
+    sky_box: tuple[RGB, RGB] = ((0.5, 0.68, 0.9), (0.9, 0.93, 0.97))  # zenith, horizon
+    # Night: the robot must carry headlamps (sim.scenario.lamps), and the render is
+    # photometric (each light's value is its lux over illuminance_lux).
+    night: bool = False
+
+    @property
+    def ambient_lux(self) -> float:
+        """The light from everywhere in lux (photometric at night only)."""
+        return self.sky_ambient[0] * self.illuminance_lux
 
     @property
     def shadows(self) -> bool:
@@ -74,6 +92,26 @@ def overcast(name: str, azimuth_deg: float, elevation_deg: float) -> Lighting:
     )  # fmt: skip
 
 
+# What the render's white stands for at night: the illuminance that fills the imx273's
+# wells at its longest exposure (30 ms) and 12 dB gain (sim.sensor: 10,470 e- / 4 at about
+# 60 e- per lux on white in 30 ms). The render reads 8 bits, so white must not stand for
+# much more: 1 lux ambient on white is 5 of its 255 steps.
+NIGHT_FULL_SCALE_LUX = 50.0
+NIGHT_AMBIENT_LUX = 1.0  # the Euro NCAP night tests' ambient light
+
+
+def night(name: str) -> Lighting:
+    """Night: 1 lux from everywhere, a black sky, no sun; lamps and headlamps light it."""
+    dark: RGB = (0.0, 0.0, 0.0)
+    moon = Sun(178.0, 66.0, shadows=False, diffuse=dark, ambient=dark, specular=dark)
+    ambient = NIGHT_AMBIENT_LUX / NIGHT_FULL_SCALE_LUX
+    return Lighting(
+        name, moon, sky_ambient=(ambient, ambient, ambient), sky_diffuse=dark,
+        illuminance_lux=NIGHT_FULL_SCALE_LUX, sky_box=(dark, dark),
+        night=True,
+    )  # fmt: skip
+
+
 # The robot drives east, so azimuth 0 is a low sun straight ahead (backlit pedestrians).
 PRESETS: dict[str, Lighting] = {
     light.name: light
@@ -86,7 +124,11 @@ PRESETS: dict[str, Lighting] = {
         # Scenarios built in code (the eight-case placement, the Euro NCAP grid, a case
         # placed on the command line) have always had this sun, 50 degrees high.
         sunny("day", 210.0, 50.0),
+        night("night"),
     )
 }
 FILE_DEFAULT = "noon"  # what a scenario file without `[scene] lighting` gets
 DAY = PRESETS["day"]
+NIGHT = PRESETS["night"]
+# The presets whose run identities write only their sun (sim.scenario.spec.scene_identity).
+SUN_ONLY_IDENTITY = ("noon", "morning", "low-sun-behind", "low-sun-ahead", "overcast", "day")

@@ -16,7 +16,8 @@ from monopic.camera import CameraModel
 from monopic.cases import Case
 from monopic.variants.zone import RobotGeometry
 from sim.scenario import presets
-from sim.scenario.lighting import DAY, PRESETS, Lighting
+from sim.scenario.lamps import Headlamps, StreetLamp
+from sim.scenario.lighting import DAY, PRESETS, SUN_ONLY_IDENTITY, Lighting
 from sim.scenario.plan import Anchor, Leg
 from sim.scenario.walkers import HumanWalker, RailWalker, Walker
 from sim.sensor.spec import SensorSpec
@@ -176,6 +177,7 @@ class RobotSpec:
     max_deceleration: float = 8.0  # braking, as a positive number
     max_speed: float = 20.0
     pitch: BodyPitch = field(default_factory=BodyPitch)  # nose dip when braking
+    headlamps: Headlamps | None = None  # its beam (sim.scenario.lamps); a night scene needs one
 
     def geometry(self) -> RobotGeometry:
         """The pipeline's own footprint: a robot knows its size (reference point = centre)."""
@@ -275,6 +277,7 @@ class SceneSpec:
     occluders: tuple[Occluder, ...] = ()  # e.g. Occluder.parked_car(x, y)
     lighting: Lighting = DAY  # sky and sun (sim.scenario.lighting: the presets)
     road: RoadLayout = field(default_factory=RoadLayout)  # the street (MuJoCo and highway-env)
+    lamps: tuple[StreetLamp, ...] = ()  # street lamps on their masts (sim.scenario.lamps)
 
 
 @dataclass(frozen=True)
@@ -366,7 +369,8 @@ def robot_identity(robot: RobotSpec) -> str:
     camera = repr(robot.camera)
     if robot.camera.sensor is None:
         camera = camera.removesuffix(", sensor=None)") + ")"
-    return repr(replace(robot, camera=_Written(camera)))
+    text = repr(replace(robot, camera=_Written(camera)))
+    return text.removesuffix(", headlamps=None)") + ")" if robot.headlamps is None else text
 
 
 def scene_identity(scene: SceneSpec) -> str:
@@ -376,12 +380,28 @@ def scene_identity(scene: SceneSpec) -> str:
     light = scene.lighting
     preset = PRESETS.get(light.name)
     sun = light.sun
-    if preset is None or light != preset.with_sun(sun.azimuth_deg, sun.elevation_deg):
-        return repr(scene)
+    if (
+        preset is None
+        or light.name not in SUN_ONLY_IDENTITY
+        or light != preset.with_sun(sun.azimuth_deg, sun.elevation_deg)
+    ):
+        text = repr(replace(scene, lighting=_Written(lighting_identity(light))))
+        return text.removesuffix(", lamps=())") + ")" if not scene.lamps else text
+    lamps = f", lamps={scene.lamps!r}" if scene.lamps else ""
     return (
         f"SceneSpec(occluders={scene.occluders!r}, sun_azimuth_deg={sun.azimuth_deg!r}, "
-        f"sun_elevation_deg={sun.elevation_deg!r}, shadows={sun.shadows!r}, road={scene.road!r})"
+        f"sun_elevation_deg={sun.elevation_deg!r}, shadows={sun.shadows!r}, road={scene.road!r}"
+        f"{lamps})"
     )
+
+
+def lighting_identity(light: Lighting) -> str:
+    """A lighting as identities have always written it: its sky box and night flag (added
+    since) only when they are not a day's."""
+    default = Lighting(light.name, light.sun)
+    text = repr(light)
+    suffix = f", sky_box={default.sky_box!r}, night=False)"
+    return text.removesuffix(suffix) + ")" if text.endswith(suffix) else text
 
 
 @dataclass(frozen=True)

@@ -1,8 +1,9 @@
 """A Lighting (sim.scenario.lighting) in MuJoCo: the sky and the lights it brings.
 
 `build_sky` sets the light from everywhere (MuJoCo's headlight) and the sky box; `lights`
-gives the lighting's light sources as entities: today the sun; a night preset's lamps
-and headlamps are more entities of the same kind.
+gives the light sources as entities: the sun (when it shines), the street lamps and the
+robot's headlamps (sim.world.entities.street_lamps, .headlamps). At night every light's
+value is photometric: its illuminance over the lighting's full scale.
 """
 
 from __future__ import annotations
@@ -12,8 +13,12 @@ import math
 import mujoco
 import numpy as np
 
+from monopic.camera import CameraModel
+from sim.scenario.lamps import Headlamps, StreetLamp
 from sim.scenario.lighting import Lighting, Sun
 from sim.world.entities.base import Entity, Moment
+from sim.world.entities.headlamps import HeadlampLights
+from sim.world.entities.street_lamps import StreetLamps
 
 SHADOW_CENTRE_AHEAD = 12.0  # m ahead of the robot where the sun's sharp-shadow region is
 
@@ -28,16 +33,31 @@ def build_sky(spec: mujoco.MjSpec, lighting: Lighting) -> None:
         name="sky",
         type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
         builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT,
-        rgb1=[0.5, 0.68, 0.9],
-        rgb2=[0.9, 0.93, 0.97],
+        rgb1=list(lighting.sky_box[0]),
+        rgb2=list(lighting.sky_box[1]),
         width=512,
         height=3072,
     )
 
 
-def lights(lighting: Lighting) -> list[Entity]:
-    """The lighting's light sources, as bodies of the scene."""
-    return [SunLight(lighting.sun)]
+def lights(
+    lighting: Lighting,
+    lamps: tuple[StreetLamp, ...] = (),
+    camera: CameraModel | None = None,
+    headlamps: Headlamps | None = None,
+    front: float = 0.0,
+) -> list[Entity]:
+    """The light sources, as bodies of the scene: the sun if it shines, then the robot's
+    headlamps (`front` m ahead of its reference point), then the street lamps (which the
+    renderer's remaining lights go to, `camera` saying which matter)."""
+    out: list[Entity] = [SunLight(lighting.sun)] if lighting.sun.shines else []
+    if headlamps is not None:
+        out.append(HeadlampLights(headlamps, front, lighting.illuminance_lux))
+    if lamps:
+        if camera is None:
+            raise ValueError("street lamps need the camera that decides which of them shine")
+        out.append(StreetLamps(lamps, lighting.illuminance_lux, camera))
+    return out
 
 
 def sun_direction(azimuth_deg: float, elevation_deg: float) -> np.ndarray:

@@ -80,7 +80,7 @@ def scene_entities(config: SceneConfig) -> list[Entity]:
     not drive and one standing pedestrian of the config's looks."""
     return [
         *parked_cars(config.spec),
-        *lights(config.spec.lighting),
+        *lights(config.spec.lighting, config.spec.lamps, config.camera),
         RobotBody(config.camera),
         PedestrianBody(config.pedestrian),
     ]

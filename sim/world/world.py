@@ -76,7 +76,13 @@ def scenario_entities(scenario: Scenario, t_end: float) -> list[Entity]:
     crowd = [CrowdDirector(scenario, people[planned:], t_end)] if scenario.crowd else []
     return [
         *parked_cars(scenario.scene),
-        *lights(scenario.scene.lighting),
+        *lights(
+            scenario.scene.lighting,
+            scenario.scene.lamps,
+            scenario.robot.camera.model(),
+            scenario.robot.headlamps,
+            scenario.robot.length / 2,
+        ),
         RobotBody(scenario.robot.camera.model(), scenario.robot),
         *crowd,
         *people,
