@@ -402,6 +402,127 @@ def score_table(scores: dict[str, CalculatorScore], claimed: set[str]) -> str:
     return "\n".join(lines)
 
 
+def halves_table(
+    halves: dict[str, dict[str, CalculatorScore]],
+    claimed: set[str],
+    tests: Sequence[str],
+    protocol: Any,
+) -> str:
+    """Day and night points on their own lines: the calculator run once per half with
+    the other half's matrices Red (sim.analysis.ncap_score.score_halves)."""
+    from sim.analysis.ncap_score import half_maximum
+
+    lines = [
+        "| policy | half | CPNA | CPFA | CPNCO | CPLA | pedestrian points |",
+        "|" + " --- |" * 7,
+    ]
+    for policy, by_half in halves.items():
+        for half, s in by_half.items():
+            run = {protocol.tests[t].load_case.split(" ")[0] for t in tests
+                   if protocol.tests[t].load_case.endswith(" " + half)}  # fmt: skip
+            cells_ = []
+            for name in ("CPNA", "CPFA", "CPNCO", "CPLA"):
+                lc = s.load_cases.get(name)
+                cells_.append("not run" if lc is None or name not in run else f"{lc.total:.3g}")
+            top = half_maximum(half, claimed)
+            lines.append(f"| {policy} | {half} | {' | '.join(cells_)} | "
+                         f"{s.pedestrian_score:.3g} / {top:g} |")  # fmt: skip
+    return "\n".join(lines)
+
+
+BANDS_M = (0.0, 10.0, 20.0, 30.0, 50.0, float("inf"))  # distance ahead of the car's front
+
+
+def detection_by_band(
+    rows: Sequence[dict[str, Any]], policy: str
+) -> dict[str, list[tuple[int, int]]] | None:
+    """{half: [(found, in sight) per distance band]} over the grid runs of the points run
+    both by day and at night (the night test's key is the day test's + "-night"), from
+    each run's per-frame SightLog; None when no point was run in both halves."""
+    from sim.analysis.ncap_score import half_of
+
+    runs = [r for r in rows if r["policy"] == policy and r["role"] == GRID
+            and r["outcome"].get("target_found")]  # fmt: skip
+
+    def key(r: dict[str, Any]) -> tuple[str, str, float, float]:
+        return (r["test"].removesuffix("-night"), r["function"], r["speed_kmh"], r["impact"])
+
+    halves = {h: {key(r) for r in runs if half_of(r["load_case"]) == h} for h in ("day", "night")}
+    both = halves["day"] & halves["night"]
+    if not both:
+        return None
+    out: dict[str, list[tuple[int, int]]] = {}
+    for half in ("day", "night"):
+        counts = [[0, 0] for _ in BANDS_M[:-1]]
+        for r in runs:
+            if half_of(r["load_case"]) != half or key(r) not in both:
+                continue
+            o = r["outcome"]
+            for found, ahead in zip(o["target_found"], o["target_range_m"], strict=True):
+                if found < 0:
+                    continue
+                b = int(np.searchsorted(BANDS_M, ahead, side="right")) - 1
+                counts[b][0] += found
+                counts[b][1] += 1
+        out[half] = [(f, n) for f, n in counts]
+    return out
+
+
+def detection_table(rows: Sequence[dict[str, Any]], policies: Sequence[str]) -> str:
+    """Detection by distance band, day against night on the same grid points (Markdown;
+    empty when no point was run in both halves)."""
+    lines = []
+    for policy in policies:
+        bands = detection_by_band(rows, policy)
+        if bands is None:
+            continue
+        if not lines:
+            head = "| policy | distance ahead | day: found / in sight | night: found / in sight |"
+            lines = [head, "|" + " --- |" * 4]
+        for k, (lo, hi) in enumerate(zip(BANDS_M[:-1], BANDS_M[1:], strict=True)):
+            span = f"{lo:g}-{hi:g} m" if np.isfinite(hi) else f">= {lo:g} m"
+            cells = []
+            for half in ("day", "night"):
+                f, n = bands[half][k]
+                cells.append(f"{f} / {n} ({f / n:.0%})" if n else "-")
+            lines.append(f"| {policy} | {span} | {' | '.join(cells)} |")
+    return "\n".join(lines)
+
+
+def _detection_lines(rows: Sequence[dict[str, Any]], policies: Sequence[str]) -> list[str]:
+    table = detection_table(rows, policies)
+    if not table:
+        return []
+    return [
+        "## Detection by distance, day against night",
+        "",
+        "Frames where the target was in sight (at least half of its landmarks in the image "
+        "and unoccluded) and the pipeline had a track on it (paired with its box as warnings "
+        "are), by its distance ahead of the car's front; only the grid points run both by "
+        "day and at night.",
+        "",
+        table,
+        "",
+    ]
+
+
+def _halves_lines(
+    halves: dict[str, dict[str, CalculatorScore]] | None,
+    claimed: set[str],
+    tests: Sequence[str],
+    protocol: Any,
+) -> list[str]:
+    if not halves or not any(halves.values()):
+        return []
+    return [
+        "Day and night on their own lines (the calculator run once per half, the other "
+        "half's matrices Red; night cases carry no robustness points):",
+        "",
+        halves_table(halves, claimed, tests, protocol),
+        "",
+    ]
+
+
 def _beside_lines(beside: Beside | None, claimed: set[str]) -> list[str]:
     if beside is None:
         return []
@@ -441,6 +562,7 @@ def render(
     out: Path,
     latency: LatencySetting,
     beside: Beside | None = None,
+    halves: dict[str, dict[str, CalculatorScore]] | None = None,
 ) -> str:
     """DIR/report.md: the calculator's points first, then how they came about."""
     claimed = {protocol.tests[t].load_case.split(" ")[0] for t in tests}
@@ -473,13 +595,15 @@ def render(
         "## Points (the calculator's compute-score)",
         "",
         "Per load case: standard + extended + robustness points of the calculator's Scenario "
-        "Scores over their maximum (day and night together: the night half is not run).",
+        "Scores over their maximum (day and night together; a half not run is claimed Red).",
         "",
         score_table(scores, claimed),
         "",
+        *_halves_lines(halves, claimed, tests, protocol),
         *_beside_lines(beside, claimed),
         f"Left unscored: {left_unscored}.",
         "",
+        *_detection_lines(rows, list(scores)),
     ]
     for policy, name in pictures:
         lines += [f"![{policy} colour matrices]({name})", ""]

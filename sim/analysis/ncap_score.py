@@ -317,6 +317,38 @@ def read_report(path: Path, version: str) -> CalculatorScore:
     return CalculatorScore(version, path, scores, ped, ped_max, verification)
 
 
+HALVES = ("day", "night")
+
+
+def half_of(load_case: str) -> str | None:
+    """ "day" or "night" for a load case that has both ("CPNA night"), else None."""
+    last = load_case.rsplit(" ", 1)[-1]
+    return last if last in HALVES else None
+
+
+def half_maximum(half: str, scenarios: set[str]) -> float:
+    """The calculator's most points for one half (standard, extended and robustness layers
+    of its TOTAL_SCORES) over the claimed tests: day 4.125 and night 3.375 for all four."""
+    from euroncap_rating_2026.crash_avoidance import data_model
+
+    return sum(
+        sum(v or 0.0 for v in layers.values())
+        for name, layers in data_model.TOTAL_SCORES.items()
+        if half_of(name) == half and name.split(" ")[0] in scenarios
+    )
+
+
+def score_halves(folder: Path, cells: list[Cell], claimed: set[str]) -> dict[str, CalculatorScore]:
+    """The calculator run once per half that has cells, the other half's matrices left
+    Red: each half's points on their own, from the official scoring (folder/day, /night)."""
+    out = {}
+    for half in HALVES:
+        own = [c for c in cells if half_of(c.load_case) == half]
+        if own:
+            out[half] = score(folder / half, own, claimed)
+    return out
+
+
 def score(folder: Path, cells: list[Cell], claimed: set[str]) -> CalculatorScore:
     """Run the calculator's three steps in `folder` (made fresh) and read its report."""
     version = require_calculator()

@@ -22,11 +22,11 @@ from sim.sensor.spec import PRESETS as CAMERAS
 
 PROTOCOL = Path("scenarios/ncap/protocol.toml")
 CAR = Path("scenarios/ncap/car.toml")
-# The protocol's day tests this grid runs, by their protocol.toml names (a test checks).
-TESTS = ("cpna", "cpfa", "cpnco", "cpla")
+# The protocol's tests this grid runs, by their protocol.toml names (a test checks): the
+# day matrices and the night ones.
+TESTS = ("cpna", "cpfa", "cpnco", "cpla", "cpna-night", "cpfa-night", "cpnco-night", "cpla-night")
 LEFT_UNSCORED = (
-    "CPNA, CPFA, CPNCO and CPLA at night (their night matrices are filled Red: not run, "
-    "no claim); CPTA (turning: needs a robot that turns and a truth that follows it); the "
+    "CPTA (turning: needs a robot that turns and a truth that follows it); the "
     "extended range (impact locations outside the standard range, filled Red); the "
     "robustness layers (all claimed NO); every cyclist, car and motorcycle load case (not "
     "claimed)"
@@ -52,9 +52,9 @@ def register(sub: argparse._SubParsersAction) -> None:
     p.add_argument(
         "--tests",
         default=",".join(TESTS),
-        help=f"comma-separated, of {', '.join(TESTS)} (the protocol's day tests: car-to-"
-        "pedestrian nearside adult, farside adult, nearside child obstructed, longitudinal "
-        "adult; default: all four)",
+        help=f"comma-separated, of {', '.join(TESTS)} (car-to-pedestrian nearside adult, "
+        "farside adult, nearside child obstructed, longitudinal adult, by day and at night: "
+        "low beams, 1 lux, the published night roads' lamps; default: all eight)",
     )
     p.add_argument("--quick", action="store_true", help="the thin grid (CI and the demo)")
     speeds = p.add_argument(
@@ -148,8 +148,8 @@ def run(args: argparse.Namespace) -> int:
     for t in tests:
         if t not in protocol.tests:
             raise UserError(
-                f"--tests: unknown test {t!r} (known: {', '.join(protocol.tests)}; night and "
-                "turning tests are not in this grid)"
+                f"--tests: unknown test {t!r} (known: {', '.join(protocol.tests)}; turning "
+                "tests are not in this grid)"
             )
     if not tests:
         raise UserError("--tests: name at least one test")
@@ -182,7 +182,7 @@ def run(args: argparse.Namespace) -> int:
         raise UserError(f"--out {args.out}: is a file, not a folder")
 
     from sim.analysis import ncap_report as rep
-    from sim.analysis.ncap_score import score
+    from sim.analysis.ncap_score import score, score_halves
     from sim.runs import ncap_grid
 
     latency = ncap_grid.latency_setting(car, args.latency_ms, args.measured_latency)
@@ -207,12 +207,14 @@ def run(args: argparse.Namespace) -> int:
     rows = ncap_grid.read_results(results, runs)
     points = rep.summarise(rows)
     claimed = {protocol.tests[t].load_case.split(" ")[0] for t in tests}
-    scores = {}
+    scores, halves = {}, {}
     for policy in policies:
         folder = args.out / "calculator" / policy.replace("/", "-")
         if folder.exists():
             shutil.rmtree(folder)
-        scores[policy] = score(folder, rep.cells(points, policy), claimed)
+        cells = rep.cells(points, policy)
+        scores[policy] = score(folder, cells, claimed)
+        halves[policy] = score_halves(folder, cells, claimed)
     pictures = []
     for policy in policies:
         name = f"matrix-{policy.replace('/', '-')}.png"
@@ -242,9 +244,12 @@ def run(args: argparse.Namespace) -> int:
         out=args.out,
         latency=latency,
         beside=beside,
+        halves=halves,
     )
     write_text_atomically(args.out / "report.md", text)
     print(rep.score_table(scores, claimed))
+    if any(halves.values()):
+        print(rep.halves_table(halves, claimed, tests, protocol))
     print(rep.latency_line(latency, car, rows))
     print(f"report: {args.out / 'report.md'}")
     return 0

@@ -52,7 +52,7 @@ from sim.runs.run_spec import ONE
 from sim.scenario.spec import Scenario
 from sim.world.ground_truth import pedestrian_passed
 from sim.world.render import RenderContext
-from sim.world.warned_for import WarnedFor, braked_wrong
+from sim.world.warned_for import WarnedFor, braked_wrong, target_found
 from sim.world.world import World, WorldStep
 
 
@@ -165,6 +165,28 @@ class PitchLog(Listener):
         self.max_deg = max(self.max_deg, math.degrees(self.world.pitch))
 
 
+SEEN = 0.5  # share of the target's landmarks in the image and unoccluded: in sight
+
+
+@dataclass
+class SightLog(Listener):
+    """Per frame: whether the target was in sight, and found by the pipeline, and how far
+    ahead of the car's front it stood (for detection by distance band, day against night)."""
+
+    front: float  # m from the robot's reference point to its front
+    found: list[int] = field(default_factory=list)  # 1 found, 0 missed, -1 not in sight
+    range_m: list[float] = field(default_factory=list)
+
+    def frame(self, frame: LoopFrame) -> None:
+        person = frame.truth.pedestrian
+        if person.visible_fraction < SEEN:
+            self.found.append(-1)
+        else:
+            self.found.append(int(target_found(frame.results.get(POLICY), frame.truth)))
+        ahead = float(np.hypot(*person.position_robot)) - self.front
+        self.range_m.append(round(max(0.0, ahead), 2))
+
+
 @dataclass(frozen=True)
 class AebOutcome:
     """One AEB run: what Euro NCAP measures and what the project adds."""
@@ -196,6 +218,10 @@ class AebOutcome:
     braked_for_on_course: bool | None = None
     people: int = 1
     braked_for_ttc: float | None = None
+    # Per processed frame (SightLog): the target found (1), missed (0) or not in sight
+    # (-1), and its distance ahead of the car's front in m.
+    target_found: tuple[int, ...] = field(repr=False, default=())
+    target_range_m: tuple[float, ...] = field(repr=False, default=())
 
     @property
     def braked(self) -> bool:
@@ -245,7 +271,8 @@ def run_aeb(
         with recording if recording is not None else nullcontext():
             log = LoopLog(footprint, policy, recording, lambda: controller.acted)
             pitch = PitchLog(world)
-            listeners: list[Listener] = [log, pitch]
+            sight = SightLog(robot.length / 2)
+            listeners: list[Listener] = [log, pitch, sight]
             if on_frame is not None:
                 listeners.append(Progress(on_frame))
             end = run_loop(
@@ -283,4 +310,6 @@ def run_aeb(
         latencies_ms=tuple(lat),
         **braked_for_fields(controller.acted if log.brake_time is not None else None),
         people=log.people,
+        target_found=tuple(sight.found),
+        target_range_m=tuple(sight.range_m),
     )

@@ -51,6 +51,14 @@ from sim.scenario.families import (
     place_turn_in,
     street_bounds,
 )
+from sim.scenario.lamps import (
+    HEADLAMPS,
+    LAMP_HEIGHT,
+    LAMP_INTENSITY_CD,
+    Headlamps,
+    StreetLamp,
+    lamp_on_road,
+)
 from sim.scenario.lighting import FILE_DEFAULT, Lighting
 from sim.scenario.lighting import PRESETS as LIGHTING
 from sim.scenario.path import pedestrian_path
@@ -659,6 +667,12 @@ def build(
     robot = _robot(top.table("robot"), preset.robot)
     _check_frame_rate(top, robot, fps)
     road, lighting = _scene(top.table("scene"), preset.road)
+    lamps = _lamps(top.table("scene"), road)
+    if lighting.night and robot.headlamps is None:
+        raise top.table("robot").error(
+            "headlamps", "none", f"a night scene needs the robot's headlamps on ([scene] "
+            f"lighting = {lighting.name!r}): headlamps = {' or '.join(map(repr, HEADLAMPS))}"
+        )  # fmt: skip
     tables = _people_tables(top)
     people: list[PedestrianSpec] = []
     case: Case | None = None
@@ -678,7 +692,7 @@ def build(
     crowd = crowd_from_table(top.table("crowd"), road)
     top.done()
     _check_names(people, [t for t, _ in tables])
-    scene = SceneSpec(occluders=occluders, road=road, lighting=lighting)
+    scene = SceneSpec(occluders=occluders, road=road, lighting=lighting, lamps=lamps)
     scenario = Scenario(
         name=name,
         pedestrian=people[0],
@@ -780,9 +794,41 @@ def _robot(t: TomlTable, preset: RobotSpec) -> RobotSpec:
         ),
         max_speed=max_speed,
         pitch=_pitch(t.table("pitch"), preset.pitch),
+        headlamps=_headlamps(t, preset.headlamps),
     )
     t.done()
     return robot
+
+
+def _headlamps(t: TomlTable, preset: Headlamps | None) -> Headlamps | None:
+    """`headlamps = "low-beam"` (sim.scenario.lamps HEADLAMPS) or "none"."""
+    default = "none" if preset is None else preset.name
+    name = t.text("headlamps", default, ("none", *HEADLAMPS))
+    return None if name == "none" else HEADLAMPS[name]
+
+
+def _lamps(t: TomlTable, road: RoadLayout) -> tuple[StreetLamp, ...]:
+    """[[scene.lamps]]: street lamps on masts, each beside the road (never on it)."""
+    lamps = []
+    for k, lt in enumerate(t.tables("lamps")):
+        lamp = StreetLamp(
+            x=lt.number("x", unit="m", low=-road.length / 2, high=road.length / 2),
+            y=lt.number("y", unit="m", low=-50.0, high=50.0),
+            height=lt.number("height", LAMP_HEIGHT, low=2.0, high=20.0, unit="m"),
+            intensity_cd=lt.number(
+                "intensity_cd", LAMP_INTENSITY_CD, positive=True, high=1e5, unit="cd"
+            ),
+            on=lt.flag("on", True),
+        )
+        if lamp_on_road(lamp, road.edges):
+            south, north = road.edges
+            raise lt.error(
+                "y", lamp.y, f"lamp {k} would stand on the road (its edges: y = {south:g} "
+                f"and {north:g} m): a mast stands beside the road"
+            )  # fmt: skip
+        lt.done()
+        lamps.append(lamp)
+    return tuple(lamps)
 
 
 def _check_frame_rate(top: TomlTable, robot: RobotSpec, fps: float) -> None:
@@ -857,6 +903,7 @@ def _scene(t: TomlTable, preset: RoadLayout) -> tuple[RoadLayout, Lighting]:
         )
     r.done()
     t.seen.add("parked_cars")  # read by _parked_cars once the path is known
+    t.seen.add("lamps")  # read by _lamps once the road is known
     t.done()
     return road, light.with_sun(azimuth, elevation)
 

@@ -14,13 +14,18 @@ impact point uniformly within the protocol's tolerances, and the families' place
 the drawn impact point exactly `steady_state_ttc + acquisition` seconds after the start.
 Crossing targets stand on the pavement at `street.start` from the car's centre line and
 walk in over their acceleration distance; a CPLA target walks ahead at its speed.
+
+Night tests (`lighting = "night"`, the calculator's night matrices) run the same
+placements in the dark: the car's low beams on (car.toml [headlamps]) and the street
+lamps of the published night road the test names (protocol.toml [lamps.NAME]: along the
+road from the crossing line, across from the car's path), or none.
 """
 
 from __future__ import annotations
 
 import hashlib
 import zlib
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -37,6 +42,8 @@ from sim.scenario.families import (
     place_crossing,
     place_longitudinal,
 )
+from sim.scenario.lamps import HEADLAMPS, LAMP_HEIGHT, Headlamps, StreetLamp, lamp_on_road
+from sim.scenario.lighting import PRESETS as LIGHTING
 from sim.scenario.sensor_table import read_sensor
 from sim.scenario.spec import (
     BodyPitch,
@@ -111,11 +118,31 @@ class NcapTest:
     acceleration_distance: float
     impact_locations: tuple[float, ...]  # the matrix's columns, left to right
     rows: tuple[Row, ...]
+    lighting: str = "day"  # a preset of sim.scenario.lighting ("night": the night matrices)
+    lamps: str | None = None  # a [lamps.NAME] layout of the protocol file, or no lamps
 
     @property
     def speed_range(self) -> tuple[float, float]:
         speeds = [v for row in self.rows for v in row.speeds_kmh]
         return min(speeds), max(speeds)
+
+
+@dataclass(frozen=True)
+class LampLayout:
+    """A night road's street lamps: along the road from the crossing line (m), across from
+    the car's path (m, positive: to its left), and whether each is lit."""
+
+    name: str
+    along: tuple[float, ...]
+    across: tuple[float, ...]
+    on: tuple[bool, ...]
+    height: float = LAMP_HEIGHT
+
+    def lamps(self, x_line: float) -> tuple[StreetLamp, ...]:
+        return tuple(
+            StreetLamp(x_line + a, c, self.height, on=o)
+            for a, c, o in zip(self.along, self.across, self.on, strict=True)
+        )
 
 
 @dataclass(frozen=True)
@@ -138,6 +165,7 @@ class Protocol:
     street: Street
     tests: dict[str, NcapTest]
     near_misses: NearMisses
+    lamps: dict[str, LampLayout] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -159,6 +187,7 @@ class CarSpec:
     pitch: BodyPitch
     # The camera's sensor (sim.sensor; None: the ideal camera, the renderer's frames).
     sensor: SensorSpec | None = None
+    headlamps: Headlamps | None = None  # its beam at night (sim.scenario.lamps)
 
     @property
     def camera_name(self) -> str:
@@ -204,8 +233,10 @@ def _texts(t: TomlTable, key: str) -> tuple[str, ...]:
     return tuple(value)
 
 
-def _numbers(t: TomlTable, key: str, low: float, high: float, unit: str) -> tuple[float, ...]:
-    values = t.numbers(key, nonempty=True, unit=unit)
+def _numbers(
+    t: TomlTable, key: str, low: float, high: float, unit: str, nonempty: bool = True
+) -> tuple[float, ...]:
+    values = t.numbers(key, nonempty=nonempty, unit=unit)
     for v in values:
         if not low <= v <= high:
             raise t.error(key, values, f"values must lie in [{low:g}, {high:g}] {unit}")
@@ -216,8 +247,9 @@ def _row(t: TomlTable, impacts: tuple[float, ...]) -> Row:
     function = t.text("function", choices=FUNCTIONS)
     speeds = _numbers(t, "speeds_kmh", 5.0, 130.0, "km/h")
     standard = _numbers(t, "standard", 0.0, 1.0, "")
-    quick_speeds = _numbers(t, "quick_speeds_kmh", 5.0, 130.0, "km/h")
-    quick_impacts = _numbers(t, "quick_impacts", 0.0, 1.0, "")
+    # The quick grid may leave a row out (empty lists).
+    quick_speeds = _numbers(t, "quick_speeds_kmh", 5.0, 130.0, "km/h", nonempty=False)
+    quick_impacts = _numbers(t, "quick_impacts", 0.0, 1.0, "", nonempty=False)
     for key, values, allowed in (
         ("standard", standard, impacts),
         ("quick_impacts", quick_impacts, standard),
@@ -229,8 +261,14 @@ def _row(t: TomlTable, impacts: tuple[float, ...]) -> Row:
     return Row(function, speeds, standard, quick_speeds, quick_impacts)
 
 
-def _test(key: str, t: TomlTable) -> NcapTest:
+def _test(key: str, t: TomlTable, layouts: dict[str, LampLayout]) -> NcapTest:
     kind = t.text("kind", choices=KINDS)
+    lighting = t.text("lighting", "day", tuple(LIGHTING))
+    lamps = t.text("lamps", None, tuple(layouts)) if layouts else t.text("lamps", None)
+    if lamps is not None and lamps not in layouts:
+        raise t.error("lamps", lamps, "the protocol file has no [lamps] layouts")
+    if lamps is not None and not LIGHTING[lighting].night:
+        raise t.error("lamps", lamps, f"street lamps light a night test (lighting = {lighting!r})")
     side = t.text("side", choices=tuple(s.value for s in Side)) if kind == "crossing" else None
     impacts = _numbers(t, "impact_locations", 0.0, 1.0, "")
     rows = tuple(_row(r, impacts) for r in t.tables("rows"))
@@ -246,9 +284,42 @@ def _test(key: str, t: TomlTable) -> NcapTest:
         acceleration_distance=t.number("acceleration_distance", low=0.0, high=10.0, unit="m"),
         impact_locations=impacts,
         rows=rows,
+        lighting=lighting,
+        lamps=lamps,
     )
     t.done()
     return test
+
+
+def _layouts(top: TomlTable, half_width: float) -> dict[str, LampLayout]:
+    """[lamps]: the night roads' lamp layouts, each mast beside the road."""
+    if not top.has("lamps"):
+        return {}
+    t = top.table("lamps")
+    height = t.number("height", LAMP_HEIGHT, low=2.0, high=20.0, unit="m")
+    out = {}
+    for name in t.free_keys():
+        if name == "height":
+            continue
+        lt = t.table(name)
+        along = _numbers(lt, "along", -500.0, 500.0, "m")
+        across = _numbers(lt, "across", -50.0, 50.0, "m")
+        on = lt.raw("on", [True] * len(along), "a list of true/false")
+        if not (isinstance(on, list) and all(isinstance(v, bool) for v in on)):
+            raise lt.error("on", on, "must be a list of true/false")
+        for key, values in (("across", across), ("on", on)):
+            if len(values) != len(along):
+                raise lt.error(key, values, f"needs one value per lamp ({len(along)}, as along)")
+        for k, y in enumerate(across):
+            if lamp_on_road(StreetLamp(0.0, y), (-half_width, half_width)):
+                raise lt.error(
+                    "across", list(across), f"lamp {k} at {y:g} m would stand on the road "
+                    f"(its edges at +-{half_width:g} m from the car's path)"
+                )  # fmt: skip
+        lt.done()
+        out[name] = LampLayout(name, along, across, tuple(on), height)
+    t.done()
+    return out
 
 
 def load_protocol(path: Path | str = PROTOCOL_FILE) -> Protocol:
@@ -284,8 +355,9 @@ def load_protocol(path: Path | str = PROTOCOL_FILE) -> Protocol:
         parked_cars_gap=st.number("parked_cars_gap", positive=True, high=5.0, unit="m"),
     )
     st.done()
+    layouts = _layouts(top, CAR.road.half_width)
     tests_table = top.table("tests")
-    tests = {key: _test(key, tests_table.table(key)) for key in tests_table.free_keys()}
+    tests = {key: _test(key, tests_table.table(key), layouts) for key in tests_table.free_keys()}
     if not tests:
         raise top.error("tests", {}, "needs at least one [tests.NAME] table")
     nm = top.table("near_misses")
@@ -313,6 +385,7 @@ def load_protocol(path: Path | str = PROTOCOL_FILE) -> Protocol:
         street=street,
         tests=tests,
         near_misses=near,
+        lamps=layouts,
     )
     top.done()
     return protocol
@@ -350,12 +423,24 @@ def load_car(path: Path | str = CAR_FILE) -> CarSpec:
             damping=pitch.number("damping", low=0.05, high=5.0),
         ),
         sensor=read_sensor(camera, None),
+        headlamps=_car_headlamps(top),
     )
     aeb.done()
     pitch.done()
     camera.done()
     top.done()
     return car
+
+
+def _car_headlamps(top: TomlTable) -> Headlamps | None:
+    """[headlamps] beam = "low-beam" (sim.scenario.lamps) or "none"; height in m."""
+    if not top.has("headlamps"):
+        return None
+    t = top.table("headlamps")
+    name = t.text("beam", choices=("none", *HEADLAMPS))
+    height = t.number("height", 0.65, low=0.3, high=1.5, unit="m")
+    t.done()
+    return None if name == "none" else replace(HEADLAMPS[name], height=height)
 
 
 # -- the grid --------------------------------------------------------------------------
@@ -447,11 +532,14 @@ def scenario_for(
         impact = point.impact + across + d.target_lateral / robot.width
         c2 = Longitudinal(impact_point=impact, impact_time=impact_time)
         pedestrian = place_longitudinal(c2, robot, speed, looks, behaviour=behaviour)
+    scene = SceneSpec(occluders=occluders, road=road)
+    if test.lighting != "day":
+        robot, scene = _lit(protocol, car, test, robot, scene, pedestrian.anchor)
     scenario = Scenario(
         name=point.id,
         pedestrian=pedestrian,
         robot=robot,
-        scene=SceneSpec(occluders=occluders, road=road),
+        scene=scene,
         family=f"ncap-{point.test}",
         duration=impact_time + timing.after_impact,
         dt=1.0 / timing.fps,
@@ -460,6 +548,33 @@ def scenario_for(
     )
     _check_road(protocol, scenario)
     return scenario
+
+
+def _lit(
+    protocol: Protocol,
+    car: CarSpec,
+    test: NcapTest,
+    robot: RobotSpec,
+    scene: SceneSpec,
+    anchor: Any,
+) -> tuple[RobotSpec, SceneSpec]:
+    """A test's lighting: its preset, the car's headlamps at night, its road's lamps."""
+    lighting = LIGHTING[test.lighting]
+    scene = replace(scene, lighting=lighting)
+    if lighting.night:
+        if car.headlamps is None:
+            raise FieldError(
+                car.path, "headlamps.beam", "none",
+                f"the night test {test.key} needs the car's headlamps: beam = "
+                f"{' or '.join(map(repr, HEADLAMPS))}",
+            )  # fmt: skip
+        robot = replace(robot, headlamps=car.headlamps)
+    if test.lamps is not None:
+        if anchor is None:
+            why = "lamps are laid out from a crossing's line: a crossing test only"
+            raise FieldError(protocol.path, f"tests.{test.key}.lamps", test.lamps, why)
+        scene = replace(scene, lamps=protocol.lamps[test.lamps].lamps(anchor.x))
+    return robot, scene
 
 
 def _check_road(protocol: Protocol, s: Scenario) -> None:

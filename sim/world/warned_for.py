@@ -85,6 +85,17 @@ def warned_for(result: FrameResult, truth: GroundTruth) -> WarnedFor | None:
     return WarnedFor(result.person_id, person.name, _ttc(person.time_to_collision))
 
 
+def target_found(result: FrameResult | None, truth: GroundTruth) -> bool:
+    """Whether one of the frame's tracks is the scripted person (the test's target), paired
+    as the warnings are: the pipeline found the target this frame."""
+    if result is None or not result.people:
+        return False
+    tracks = [[p.person_id, *p.box] for p in result.people]
+    width, height = result.image_size
+    pairs = match_tracks(tracks, [p.box for p in truth.people], width, height)
+    return 0 in pairs.values()
+
+
 def oracle_warned_for(truth: GroundTruth) -> WarnedFor:
     """The oracle policy's warning: the scripted person's truth (it warns on their course)."""
     return WarnedFor(None, truth.pedestrian.name, _ttc(truth.pedestrian.time_to_collision))
