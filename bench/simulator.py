@@ -45,10 +45,18 @@ and the frame time with the draws capped at each of BLUR_DRAWS; and the floor of
 from a per-pixel motion field: a segmentation render and a depth read per frame, next to
 the render. `--camera-only` runs that part alone.
 
+And as a line of its own (benchmark `simulator_night`), what a night frame costs: the Euro
+NCAP CPNA point at 40 km/h, impact 50 % (sim.scenario.ncap, nominal draw) by day and at
+night through the car's camera (imx273), and at night through the ideal camera (one draw,
+the lights alone) and through imx273 with its draws capped at one (the exposure's motion
+blur off), the worlds stepped in turns as the camera part does; step p50/p95, draws a
+frame, exposure and gain, the ratio of each against the day frame. `--night-only` runs
+that part alone.
+
 The `--...-only` options choose parts (several may be given); with none, every part runs.
 
     .venv/bin/python -m bench.simulator [--frames 60] [--runs 6] [--people-only]
-        [--crowd-only] [--people-runs-only] [--camera-only] [--no-append]
+        [--crowd-only] [--people-runs-only] [--camera-only] [--night-only] [--no-append]
 """
 
 from __future__ import annotations
@@ -88,6 +96,7 @@ WARM_STEPS = 2  # steps of each world not timed (the new scene's first draws)
 CAMERA_TITLE = "Simulator: a real camera's frame (sensor, motion blur) against the ideal camera's"
 CAMERA_GOAL_X = 1.5  # the goal: the real camera's frame time within 1.5x the ideal camera's
 CAMERA_PARTS = ("render", "truth", "linear", "readout", "motion")
+NIGHT_TITLE = "Simulator: a night frame (low beams, lamps, 1 lux) against the day frame"
 FAST_SPEED = 13.9  # m/s (50 km/h): the car in town, where a long exposure smears most
 BLUR_EXPOSURE_MS = 30.0  # IMX273's longest exposure, fixed: the blur rows' long exposure
 BLUR_DRAWS = (1, 2, 4, 8)  # the sub-frame caps (SensorSpec.max_subframes) timed side by side
@@ -704,6 +713,78 @@ def child_camera(
     return res
 
 
+def night_scenarios(frames: int) -> dict[str, Any]:
+    """The CPNA point by day and at night (imx273), at night through the ideal camera and
+    through imx273 with one draw a frame, each cut to `frames` frames."""
+    from dataclasses import replace
+
+    from sim.scenario.ncap import Draw, GridPoint, load_car, load_protocol, scenario_for
+
+    protocol, car = (
+        load_protocol(ROOT / "scenarios/ncap/protocol.toml"),
+        load_car(ROOT / "scenarios/ncap/car.toml"),
+    )
+    day, night = (
+        scenario_for(protocol, car, GridPoint(test, "AEB", 40.0, 0.5), Draw.nominal())
+        for test in ("cpna", "cpna-night")
+    )
+    cut = {name: replace(sc, duration=frames * sc.dt) for name, sc in
+           (("day", day), ("night", night))}  # fmt: skip
+    sensor = night.robot.camera.sensor
+    cut["night_ideal"] = with_sensor(cut["night"], None)
+    cut["night_one_draw"] = with_sensor(cut["night"], replace(sensor, max_subframes=1))
+    return cut
+
+
+def child_night(frames: int, rounds: int = 2) -> dict[str, Any]:
+    """The night frame against the day frame (night_scenarios), stepped in turns."""
+    import numpy as np
+
+    if frames <= WARM_STEPS + 1:
+        raise ValueError(f"frames must be more than {WARM_STEPS + 1}, got {frames}")
+    recs: dict[str, CameraRecord] = {}
+    with camera_parts() as watches:
+        for _ in range(rounds):
+            step_in_turns(night_scenarios(frames), frames, watches, recs)
+    res: dict[str, Any] = {"rounds": rounds}
+    for name, rec in recs.items():
+        row = camera_summary(rec)
+        ratios = np.array(rec["step"]) / np.array(recs["day"]["step"])
+        row["paired_ratio_p50_x"] = float(np.percentile(ratios, 50))
+        res[name] = row
+    res["maxrss_mb"] = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    return res
+
+
+def night_report(got: dict[str, Any], frames: int) -> tuple[dict[str, Any], str]:
+    """The night child's figures as history results and a Markdown table."""
+    timed = frames - 1 - WARM_STEPS
+    lines = [
+        "Scenario: the Euro NCAP CPNA point at 40 km/h, impact 50 %, nominal draw "
+        "(sim.scenario.ncap), 768x432, World.step with rendering on one core, the worlds "
+        f"stepped in turns frame by frame, {timed} timed steps per world and round, "
+        f"{got['rounds']} rounds. Night: low beams (2 cones), the nearside night road's "
+        "lamps (5 lit, at most 5 shining a frame), 1 lux.",
+        "",
+        "| world | step p50 ms | step p95 ms | x day (paired p50) | render p50 ms | draws a "
+        "frame (mean, max) | exposure p50 ms | gain p50 |",
+        "|" + " --- |" * 8,
+    ]
+    results: dict[str, Any] = {}
+    for name in ("day", "night", "night_ideal", "night_one_draw"):
+        r = got[name]
+        results[name] = r
+        exposure = "-" if r["exposure_p50_ms"] is None else f"{r['exposure_p50_ms']:.2g}"
+        gain = "-" if r["gain_p50"] is None else f"{r['gain_p50']:.0f}"
+        lines.append(
+            f"| {name} | {r['step_p50_ms']:.1f} | {r['step_p95_ms']:.1f} | "
+            f"{r['paired_ratio_p50_x']:.2f} | {r['render_p50_ms']:.1f} | "
+            f"{r['draws_mean']:.1f}, {r['draws_max']} | {exposure} | {gain} |"
+        )
+    results["maxrss_mb"] = got["maxrss_mb"]
+    return results, "\n".join(lines)
+
+
 def camera_report(got: dict[str, Any], frames: int) -> tuple[dict[str, Any], str]:
     """The camera child's figures as history results and a Markdown table."""
     import numpy as np
@@ -1065,8 +1146,13 @@ def main() -> None:
         "(its own history line)",
     )  # fmt: skip
     ap.add_argument(
+        "--night-only", action="store_true",
+        help="only a night frame (low beams, lamps, 1 lux) against the day frame (its own "
+        "history line)",
+    )  # fmt: skip
+    ap.add_argument(
         "--child",
-        choices=("render", "run", "sweep", "people", "crowd", "people_runs", "camera"),
+        choices=("render", "run", "sweep", "people", "crowd", "people_runs", "camera", "night"),
         help=argparse.SUPPRESS,
     )
     ap.add_argument("--people", type=int, nargs="+", default=PEOPLE, help=argparse.SUPPRESS)
@@ -1091,6 +1177,8 @@ def main() -> None:
             out = child_people_runs(args.frames, args.people, args.rounds)
         elif args.child == "camera":
             out = child_camera(args.frames, args.rounds)
+        elif args.child == "night":
+            out = child_night(args.frames, args.rounds)
         elif args.child == "run":
             out = child_run(
                 args.frames, bool(args.ablation), bool(args.shadows), args.model, args.runtime
@@ -1128,9 +1216,15 @@ def main() -> None:
         results, table = camera_report(got, args.frames)
         print(table)
         recorder.finish(results, table, write=not args.no_append)
+    if "night" in parts:
+        recorder = Recorder("simulator_night", NIGHT_TITLE)
+        got = spawn_child("night", True, frames=args.frames, rounds=args.rounds)
+        results, table = night_report(got, args.frames)
+        print(table)
+        recorder.finish(results, table, write=not args.no_append)
 
 
-ONLY = ("people_runs", "crowd", "people", "camera")  # the parts an `--X-only` option names
+ONLY = ("people_runs", "crowd", "people", "camera", "night")  # the parts an `--X-only` option names
 
 
 def chosen_parts(args: argparse.Namespace) -> set[str]:

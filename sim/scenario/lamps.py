@@ -17,7 +17,8 @@ than a real one and brighter under them; tools/night_calibration.py measures bot
 Low beam. A regulation low beam (UN R112 class B, its test points as the project read
 them, in candela per lamp at 25 m: 50V at 0.86 deg down >= 3,750 cd; 50R at 0.86 deg down,
 1.72 deg right >= 7,500 cd; 75R at 0.57 down, 1.15 right >= 7,500 cd; 25L and 25R at 1.72
-down, 9 left and right >= 1,250 cd; B50L at 0.57 up, 3.43 left <= 250 cd; zone III above
+down, 9 left and right >= 1,250 cd; 50L at 0.86 down, 3.43 left <= 9,375 cd; B50L at
+0.57 up, 3.43 left <= 250 cd; zone III above
 the cut-off <= 437 cd) has a flat cut-off 0.57 deg below the horizon: the road is lit, a
 pedestrian's upper body beyond a few metres much less. MuJoCo's spot lights are round
 cones, so the beam is built from cones whose tops touch the cut-off line: a wide cone aimed
@@ -122,7 +123,7 @@ R112_POINTS: tuple[tuple[str, float, float, float, bool], ...] = (
     ("75R", 0.57, 1.15, 7500.0, True),
     ("50R", 0.86, 1.72, 7500.0, True),
     ("50V", 0.86, 0.0, 3750.0, True),
-    ("50L", 0.86, -3.43, 3750.0, True),
+    ("50L", 0.86, -3.43, 9375.0, False),
     ("25L", 1.72, -9.0, 1250.0, True),
     ("25R", 1.72, 9.0, 1250.0, True),
     ("zone III (1 deg up)", -1.0, 0.0, 437.0, False),

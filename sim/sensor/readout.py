@@ -37,6 +37,15 @@ def linear_light(image: np.ndarray) -> np.ndarray:
     return cv2.LUT(image, LINEAR_OF_U8)  # a few times faster than numpy's indexing
 
 
+LINEAR_OF_LINEAR_U8 = (np.arange(256) / 255.0).astype(np.float32)
+
+
+def photometric_light(image: np.ndarray) -> np.ndarray:
+    """A photometric render (night: each light's value is its lux over the full scale, so
+    the renderer's output is already linear in light) as linear light: no sRGB decoding."""
+    return cv2.LUT(image, LINEAR_OF_LINEAR_U8)
+
+
 POOL_SIZE = 1 << 22  # standard normal deviates a sensor draws once per run (16 MB)
 
 

@@ -36,6 +36,7 @@ from sim.world.street import build_street
 SCENE_EXTENT = 100.0  # m; MuJoCo's clip planes and shadow box are fractions of this
 NEAR_CLIP = 0.05  # m
 FAR_CLIP = 400.0  # m
+NIGHT_GRID = 1.0  # m, the street's lit grid at night (sim.world.street)
 
 
 def default_camera() -> CameraModel:
@@ -110,7 +111,8 @@ def build_spec(config: SceneConfig, entities: Sequence[Entity]) -> mujoco.MjSpec
     vis.map.zfar = FAR_CLIP / SCENE_EXTENT
     vis.map.shadowclip = config.shadow_half_extent / SCENE_EXTENT
     build_sky(spec, config.spec.lighting)
-    build_street(spec, config.spec.road)
+    lit_grid = NIGHT_GRID if config.spec.lighting.night else None
+    build_street(spec, config.spec.road, lit_grid)
     for entity in entities:
         entity.build(spec)
     return spec

@@ -24,7 +24,7 @@ from dataclasses import replace
 import numpy as np
 
 from sim.sensor.exposure import ExposureState
-from sim.sensor.readout import linear_light
+from sim.sensor.readout import linear_light, photometric_light
 from sim.sensor.sensor import Sensor
 from sim.world.scene import Scene, SceneState
 
@@ -41,10 +41,13 @@ class Shutter:
     """Exposes each frame of one world: `capture(render, interval)` after the world placed
     its bodies for the frame."""
 
-    def __init__(self, sensor: Sensor, scene: Scene) -> None:
+    def __init__(self, sensor: Sensor, scene: Scene, photometric: bool = False) -> None:
+        """`photometric`: the render is linear in light (a night lighting's), so it is read
+        as it is; otherwise it is a display image, sRGB-decoded to linear light."""
         self.sensor = sensor
         self.scene = scene
         self.previous: SceneState | None = None
+        self.to_light = photometric_light if photometric else linear_light
 
     def reset(self, seed: int) -> None:
         self.sensor.reset(seed)
@@ -58,7 +61,7 @@ class Shutter:
         current = scene.snapshot()
         previous, self.previous = self.previous, current
         if not sensor.metered:
-            light = linear_light(render())
+            light = self.to_light(render())
             sensor.meter(light)
             return sensor.read(light, sensor.settings())
         state = sensor.settings()
@@ -68,13 +71,13 @@ class Shutter:
             blur = scene.image_motion(previous, current) * share
             draws = subframes(blur, spec.blur_step_px, spec.max_subframes)
         if draws == 1:
-            light = linear_light(render())
+            light = self.to_light(render())
         else:
             assert previous is not None
             light = np.zeros((scene.camera.height, scene.camera.width, 3), np.float32)
             for k in range(draws):
                 scene.blend(previous, current, 1.0 - share * (1.0 - k / (draws - 1)))
-                light += linear_light(render())
+                light += self.to_light(render())
             scene.blend(current, current, 1.0)
             light *= np.float32(1.0 / draws)
         return sensor.read(light, replace(state, subframes=draws))

@@ -5,6 +5,13 @@ has its top at z = 0 so that the ground plane of monopic's camera model is exact
 sits a few millimetres above the asphalt (as real paint does) so it never z-fights.
 Surfaces are thin boxes with procedural textures (asphalt grain, paving slabs, grass),
 markings are thin white boxes, all added to an MjSpec in code.
+
+At night the flat surfaces are planes drawn as grids of `lit_grid`-metre quads instead:
+MuJoCo's classic renderer lights per vertex, so a box face (one quad) is lit only at its
+corners, and a 400 m road took no light from a lamp 5 m above it nor from the low beams
+(tools/night_calibration.py). By day the sun, a directional light, lights a box face
+evenly, so the boxes stay (a plane's grid cost software GL 16 ms of a 46 ms frame). The
+facades stay boxes at night: they take the lamps' light at their corners only.
 """
 
 from __future__ import annotations
@@ -30,6 +37,7 @@ GRASS_UNDER = 0.25  # m the grass reaches under the pavements' outer edges (no c
 # it cost 4-11 % of a frame's render (with _add_grass's change, 0.84 of the render time
 # in all: `bench/render_ab.py`).
 SURFACE_GROUP = 2
+GRASS_GRID_X = 5.0  # the grass's grid at night, in the street's grid: seen far off, if at all
 
 
 def _texture(spec: mujoco.MjSpec, name: str, **kw: object) -> None:
@@ -87,9 +95,23 @@ def _surface(
     centre: tuple[float, float, float],
     half: tuple[float, float, float],
     material: str,
+    grid: float | None = None,
 ) -> None:
-    """A box lying flat on the ground (slab, paint, grass): drawn, but casts no shadow."""
-    add_box(spec, name, centre, half, material, group=SURFACE_GROUP)
+    """A box lying flat on the ground (slab, paint, grass): drawn, but casts no shadow.
+    With `grid` (m), a plane at the box's top drawn as a grid of that spacing instead."""
+    if grid is None:
+        add_box(spec, name, centre, half, material, group=SURFACE_GROUP)
+        return
+    spec.worldbody.add_geom(
+        name=name,
+        type=mujoco.mjtGeom.mjGEOM_PLANE,
+        pos=[centre[0], centre[1], centre[2] + half[2]],
+        size=[half[0], half[1], grid],
+        material=material,
+        contype=0,
+        conaffinity=0,
+        group=SURFACE_GROUP,
+    )
 
 
 def _grid_centre(inner: float, outer: float, origin: float, period: float) -> float:
@@ -100,9 +122,10 @@ def _grid_centre(inner: float, outer: float, origin: float, period: float) -> fl
     return origin + math.copysign(periods * period, outer - inner)
 
 
-def build_street(spec: mujoco.MjSpec, road: RoadLayout) -> None:
+def build_street(spec: mujoco.MjSpec, road: RoadLayout, lit_grid: float | None = None) -> None:
     """Add ground, road, markings, pavements and buildings to `spec` (parked cars are
-    entities of their own: sim.world.entities.parked_car)."""
+    entities of their own: sim.world.entities.parked_car). `lit_grid` (m): the flat
+    surfaces as planes of that grid, for lights that are not the sun (module docstring)."""
     _texture(
         spec,
         "asphalt",
@@ -136,7 +159,7 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout) -> None:
     paint = add_material(spec, "paint", (0.92, 0.92, 0.9, 1), specular=0.1)
     kerb = add_material(spec, "kerb", (0.72, 0.71, 0.68, 1))
 
-    _add_grass(spec, road, grass)
+    _add_grass(spec, road, grass, None if lit_grid is None else GRASS_GRID_X * lit_grid)
     half_len = road.length / 2
     y_right, y_left = road.edges
     _surface(
@@ -145,6 +168,7 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout) -> None:
         (0, road.center_y, -SLAB_DEPTH / 2),
         (half_len, road.half_width, SLAB_DEPTH / 2),
         asphalt,
+        lit_grid,
     )
     for name, sign, edge in (("south", -1.0, y_right), ("north", 1.0, y_left)):
         _surface(
@@ -153,6 +177,7 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout) -> None:
             (0, edge + sign * KERB_WIDTH / 2, -SLAB_DEPTH / 2),
             (half_len, KERB_WIDTH / 2, SLAB_DEPTH / 2),
             kerb,
+            lit_grid,
         )
         pav_centre = edge + sign * (KERB_WIDTH + road.pavement_width / 2)
         _surface(
@@ -161,6 +186,7 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout) -> None:
             (0, pav_centre, -SLAB_DEPTH / 2),
             (half_len, road.pavement_width / 2, SLAB_DEPTH / 2),
             slabs,
+            lit_grid,
         )
 
     paint_half_h = PAINT_HEIGHT / 2
@@ -168,7 +194,12 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout) -> None:
     # Solid edge lines.
     for name, y in (("south", y_right + 0.25), ("north", y_left - 0.25)):
         _surface(
-            spec, f"edge_line_{name}", (0, y, paint_half_h), (half_len, lw, paint_half_h), paint
+            spec,
+            f"edge_line_{name}",
+            (0, y, paint_half_h),
+            (half_len, lw, paint_half_h),
+            paint,
+            lit_grid,
         )
     # Dashed separators between lanes, with a gap across the zebra crossing.
     period = road.dash_length + road.dash_gap
@@ -206,7 +237,9 @@ def build_street(spec: mujoco.MjSpec, road: RoadLayout) -> None:
         _add_buildings(spec, road)
 
 
-def _add_grass(spec: mujoco.MjSpec, road: RoadLayout, grass: str) -> None:
+def _add_grass(
+    spec: mujoco.MjSpec, road: RoadLayout, grass: str, grid: float | None = None
+) -> None:
     """Grass everywhere off the street, 1 cm below it, out to 1.5 road lengths each way.
 
     Four boxes around the street rather than one under everything: software GL shaded
@@ -227,14 +260,14 @@ def _add_grass(spec: mujoco.MjSpec, road: RoadLayout, grass: str) -> None:
         ("ground_north", y_left + reach, cy + extent),
     ):
         yc = _grid_centre(inner, outer, cy, period)
-        _surface(spec, name, (0.0, yc, z), (extent, abs(yc - inner), half_z), grass)
+        _surface(spec, name, (0.0, yc, z), (extent, abs(yc - inner), half_z), grass, grid)
     half_street = max(y_left + reach - cy, cy - (y_right - reach)) + GRASS_UNDER
     for name, inner, outer in (
         ("ground_west", -road.length / 2 + GRASS_UNDER, -extent),
         ("ground_east", road.length / 2 - GRASS_UNDER, extent),
     ):
         xc = _grid_centre(inner, outer, 0.0, period)
-        _surface(spec, name, (xc, cy, z), (abs(xc - inner), half_street, half_z), grass)
+        _surface(spec, name, (xc, cy, z), (abs(xc - inner), half_street, half_z), grass, grid)
 
 
 def _facade_texture(spec: mujoco.MjSpec, name: str, wall: RGB) -> None:

@@ -120,8 +120,12 @@ class World(Closing):
         sensor = scenario.robot.camera.sensor
         self.shutter: Shutter | None = None
         if sensor is not None and render:
-            lux = scenario.scene.lighting.illuminance_lux
-            self.shutter = Shutter(Sensor(sensor, lux, scenario.dt, scenario.seed), self.scene)
+            light = scenario.scene.lighting
+            self.shutter = Shutter(
+                Sensor(sensor, light.illuminance_lux, scenario.dt, scenario.seed),
+                self.scene,
+                photometric=light.night,
+            )
         self._frame_time = 0.0
         self.road: Road | None = None
         self.time = 0.0

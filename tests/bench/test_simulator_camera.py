@@ -25,7 +25,7 @@ def test_the_only_options_choose_their_parts_and_none_runs_them_all() -> None:
     assert simulator.chosen_parts(only(camera=True)) == {"camera"}
     assert simulator.chosen_parts(only(camera=True, people=True)) == {"camera", "people"}
     everything = simulator.chosen_parts(only())
-    assert everything == {"main", "people_runs", "crowd", "people", "camera"}
+    assert everything == {"main", "people_runs", "crowd", "people", "camera", "night"}
 
 
 def test_the_blur_rows_drive_the_car_fast_under_clouds_with_a_fixed_long_exposure() -> None:

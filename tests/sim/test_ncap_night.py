@@ -170,3 +170,28 @@ def test_the_calculators_halves_are_its_day_and_night_maxima() -> None:
     tests = {"CPNA", "CPFA", "CPNCO", "CPLA"}
     assert half_maximum("day", tests) == pytest.approx(4.125)
     assert half_maximum("night", tests) == pytest.approx(3.375)
+
+
+def _row(test: str, load_case: str, found: list[int], ahead: list[float]) -> dict:
+    return {
+        "policy": "rules/ground", "role": "grid", "test": test, "function": "AEB",
+        "speed_kmh": 40.0, "impact": 0.5, "load_case": load_case,
+        "outcome": {"target_found": found, "target_range_m": ahead},
+    }  # fmt: skip
+
+
+def test_detection_is_counted_by_band_on_the_points_run_by_day_and_at_night() -> None:
+    from sim.analysis.ncap_report import detection_by_band, detection_table
+
+    rows = [
+        _row("cpna", "CPNA day", [1, 1, 0, -1], [35.0, 15.0, 5.0, 2.0]),
+        _row("cpna-night", "CPNA night", [0, 1, -1], [35.0, 15.0, 5.0]),
+        _row("cpfa", "CPFA day", [1, 1], [15.0, 12.0]),  # no night twin: left out
+    ]
+    bands = detection_by_band(rows, "rules/ground")
+    assert bands is not None
+    assert bands["day"] == [(0, 1), (1, 1), (0, 0), (1, 1), (0, 0)]
+    assert bands["night"] == [(0, 0), (1, 1), (0, 0), (0, 1), (0, 0)]
+    table = detection_table(rows, ["rules/ground"])
+    assert "| rules/ground | 30-50 m | 1 / 1 (100%) | 0 / 1 (0%) |" in table
+    assert detection_by_band(rows[:1], "rules/ground") is None

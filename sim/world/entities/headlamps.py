@@ -40,7 +40,7 @@ class HeadlampLights(Entity):
                 exponent=0,
                 attenuation=[0, 0, 1],
                 castshadow=False,
-                diffuse=[value, value, value * 0.95],
+                diffuse=[value, value, value],
                 ambient=[0, 0, 0],
                 specular=[0, 0, 0],
             )

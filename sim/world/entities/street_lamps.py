@@ -68,7 +68,7 @@ class StreetLamps(Entity):
                 name=f"{self.prefix}{k}/head",
                 type=mujoco.mjtGeom.mjGEOM_BOX,
                 size=[0.3, 0.15, 0.06],
-                pos=[0, 0, lamp.height],
+                pos=[0, 0, lamp.height + 0.06],  # above its light, which hangs at the height
                 rgba=[0.2, 0.2, 0.2, 1],
                 material=self.prefix + "glow" if lamp.on else "",
                 contype=0,
@@ -80,13 +80,13 @@ class StreetLamps(Entity):
             body.add_light(
                 name=f"{self.prefix}{k}/light",
                 type=mujoco.mjtLightType.mjLIGHT_SPOT,
-                pos=[0, 0, lamp.height - 0.1],
+                pos=[0, 0, lamp.height],
                 dir=[0, 0, -1],
                 cutoff=lamp.cutoff_deg,
                 exponent=0,
                 attenuation=[0, 0, 1],
                 castshadow=False,
-                diffuse=[value, value * 0.95, value * 0.85],
+                diffuse=[value, value, value],  # white: the lux stated in every channel
                 ambient=[0, 0, 0],
                 specular=[0, 0, 0],
             )
