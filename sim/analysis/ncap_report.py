@@ -267,15 +267,25 @@ def latency_line(latency: LatencySetting, car: CarSpec, rows: Sequence[dict[str,
 def plot_matrices(
     protocol: Protocol, points: Sequence[PointSummary], policy: str, tests: list[str], out: Path
 ) -> None:
-    """One picture per policy: each load case's matrix, cells coloured by the prediction."""
+    """One picture per policy: each load case's matrix, cells coloured by the prediction;
+    one row of matrices per lighting (day, then night)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
     mine = {(p.test, p.function, p.speed_kmh, p.impact): p for p in points if p.policy == policy}
-    fig, axes = plt.subplots(1, len(tests), figsize=(4.2 * len(tests), 4.8), squeeze=False)
-    for ax, key in zip(axes[0], tests, strict=True):
+    lightings = list(dict.fromkeys(protocol.tests[t].lighting for t in tests))
+    grid = [[t for t in tests if protocol.tests[t].lighting == light] for light in lightings]
+    ncols = max(len(g) for g in grid)
+    fig, axes = plt.subplots(
+        len(grid), ncols, figsize=(4.2 * ncols, 4.8 * len(grid)), squeeze=False
+    )
+    for r, row_tests in enumerate(grid):
+        for ax in axes[r][len(row_tests) :]:
+            ax.set_visible(False)
+    placed = [(axes[r][c], key) for r, g in enumerate(grid) for c, key in enumerate(g)]
+    for ax, key in placed:
         test = protocol.tests[key]
         rows = [(row.function, v) for row in test.rows for v in row.speeds_kmh]
         cols = list(test.impact_locations)
