@@ -195,3 +195,32 @@ def test_detection_is_counted_by_band_on_the_points_run_by_day_and_at_night() ->
     table = detection_table(rows, ["rules/ground"])
     assert "| rules/ground | 30-50 m | 1 / 1 (100%) | 0 / 1 (0%) |" in table
     assert detection_by_band(rows[:1], "rules/ground") is None
+
+
+@pytest.mark.slow
+def test_the_night_point_runs_and_is_scored_on_its_own_line(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    import json
+
+    from monopic.cli.main import main
+
+    pytest.importorskip("euroncap_rating_2026")
+    out = tmp_path / "ncap"
+    argv = ["ncap", "--tests", "cpna,cpna-night", "--quick", "--speeds-kmh", "40",
+            "--runs-per-point", "1", "--policies", "rules/ground", "--no-near-misses",
+            "--workers", "2", "--out", str(out)]  # fmt: skip
+    assert main(argv) == 0
+    rows = [json.loads(line) for line in (out / "results.jsonl").read_text().splitlines()]
+    assert sorted(r["load_case"] for r in rows) == ["CPNA day"] * 2 + ["CPNA night"] * 2
+    assert {r["lighting"] for r in rows if r["test"] == "cpna-night"} == {"night"}
+    for row in rows:  # each frame: found, missed or out of sight, and how far ahead
+        o = row["outcome"]
+        assert len(o["target_found"]) == len(o["target_range_m"]) > 0
+        assert set(o["target_found"]) <= {-1, 0, 1}
+    printed = capsys.readouterr().out
+    for half, top in (("day", "0.6875"), ("night", "0.5625")):
+        assert f"| rules/ground | {half} | " in printed and f" / {top} |" in printed
+    report = (out / "report.md").read_text()
+    assert "## Detection by distance, day against night" in report
+    assert list((out / "calculator" / "rules-ground" / "night").glob("ca_*_report.xlsx"))

@@ -8,7 +8,8 @@ Each frame, the lamps whose light covers most of the image shine: a lamp's score
 illuminance it puts on ground points around its foot that the camera sees, each weighed
 by the image area it covers (1 / distance^2). The other lamps' light is left out; what that
 costs is measured in tools/night_calibration.py against the exact image (the scene drawn
-in several passes, each with at most 7 lights, summed: the renderer is linear below white).
+in several passes, each with at most 7 lights, summed: the renderer adds lights linearly
+per vertex, up to the full scale, where it clamps: docs/night/calibration.md).
 
 Lamps cast no shadows: each shadowed light adds a render pass (a probe: 12.6 ms a frame
 without, 58 ms with one shadowed light, 543 ms with eight).
