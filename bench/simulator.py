@@ -1210,18 +1210,14 @@ def main() -> None:
         results, table = people_report(people, args.frames)
         print(table)
         recorder.finish(results, table, write=not args.no_append)
-    if "camera" in parts:
-        recorder = Recorder("simulator_camera", CAMERA_TITLE)
-        got = spawn_child("camera", True, frames=args.frames, rounds=args.rounds)
-        results, table = camera_report(got, args.frames)
-        print(table)
-        recorder.finish(results, table, write=not args.no_append)
-    if "night" in parts:
-        recorder = Recorder("simulator_night", NIGHT_TITLE)
-        got = spawn_child("night", True, frames=args.frames, rounds=args.rounds)
-        results, table = night_report(got, args.frames)
-        print(table)
-        recorder.finish(results, table, write=not args.no_append)
+    for part, title, report in (("camera", CAMERA_TITLE, camera_report),
+                                ("night", NIGHT_TITLE, night_report)):  # fmt: skip
+        if part in parts:
+            recorder = Recorder(f"simulator_{part}", title)
+            got = spawn_child(part, True, frames=args.frames, rounds=args.rounds)
+            results, table = report(got, args.frames)
+            print(table)
+            recorder.finish(results, table, write=not args.no_append)
 
 
 ONLY = ("people_runs", "crowd", "people", "camera", "night")  # the parts an `--X-only` option names
