@@ -151,7 +151,8 @@ def _cells(avoided: bool) -> list[Cell]:
         if avoided:
             v = 3.0 if pt.function == "FCW" else 0.0
         else:  # every impact at full (relative) speed; no warning at all
-            v = 0.0 if pt.function == "FCW" else pt.speed_kmh - (5.0 if pt.test == "cpla" else 0)
+            longitudinal = PROTOCOL.tests[pt.test].kind == "longitudinal"
+            v = 0.0 if pt.function == "FCW" else pt.speed_kmh - (5.0 if longitudinal else 0)
         cells.append(Cell(case, pt.function, pt.speed_kmh, pt.impact,
                           band_colour(case, pt.function, pt.speed_kmh, v), v))  # fmt: skip
     return cells
@@ -163,10 +164,12 @@ def test_the_calculator_scores_hand_made_cases(tmp_path):
 
     claimed = {"CPNA", "CPFA", "CPNCO", "CPLA"}
     best = score(tmp_path / "avoided", _cells(True), claimed)
-    for name, lc in best.load_cases.items():  # the day half of every standard range
-        assert lc.standard == pytest.approx(data_model.TOTAL_SCORES[f"{name} day"]["Standard"])
+    for name, lc in best.load_cases.items():  # both halves of every standard range
+        halves = [data_model.TOTAL_SCORES[f"{name} {half}"] for half in ("day", "night")]
+        top = sum(h["Standard"] for h in halves)
+        assert lc.standard == pytest.approx(top)
         assert lc.extended == 0 and lc.robustness == 0  # not run, not claimed
-    assert best.pedestrian_score == pytest.approx(3.0)
+    assert best.pedestrian_score == pytest.approx(6.0)
     assert best.verification and all(v["Colour"] == "Green" for v in best.verification)
     worst = score(tmp_path / "hit", _cells(False), claimed)
     assert worst.pedestrian_score == 0 and worst.ped_cyc_score == 0
