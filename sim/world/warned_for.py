@@ -75,10 +75,7 @@ def warned_for(result: FrameResult, truth: GroundTruth) -> WarnedFor | None:
     judge of the whole frame would give the warned track."""
     if result.person_id is None:
         return None
-    tracks = [[p.person_id, *p.box] for p in result.people]
-    width, height = result.image_size
-    pairs = match_tracks(tracks, [p.box for p in truth.people], width, height)
-    k = pairs.get(result.person_id)
+    k = frame_pairs(result, truth).get(result.person_id)
     if k is None:
         return WarnedFor(result.person_id, NOBODY, None)
     person = truth.people[k]
@@ -90,10 +87,15 @@ def target_found(result: FrameResult | None, truth: GroundTruth) -> bool:
     as the warnings are: the pipeline found the target this frame."""
     if result is None or not result.people:
         return False
+    return 0 in frame_pairs(result, truth).values()
+
+
+def frame_pairs(result: FrameResult, truth: GroundTruth) -> dict[int, int]:
+    """{track id: person index}: every track of the frame paired with the people's boxes
+    (sim.geometry.box_match, one to one)."""
     tracks = [[p.person_id, *p.box] for p in result.people]
     width, height = result.image_size
-    pairs = match_tracks(tracks, [p.box for p in truth.people], width, height)
-    return 0 in pairs.values()
+    return match_tracks(tracks, [p.box for p in truth.people], width, height)
 
 
 def oracle_warned_for(truth: GroundTruth) -> WarnedFor:
