@@ -61,11 +61,6 @@ class Lighting:
     night: bool = False
 
     @property
-    def ambient_lux(self) -> float:
-        """The light from everywhere in lux (photometric at night only)."""
-        return self.sky_ambient[0] * self.illuminance_lux
-
-    @property
     def shadows(self) -> bool:
         """Whether anything casts a shadow (the render then makes a shadow pass)."""
         return self.sun.shadows
