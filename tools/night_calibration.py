@@ -49,7 +49,7 @@ from monopic.camera import CameraModel
 from monopic.output import atomic_path
 from sim.runs.runner import machine
 from sim.scenario.families import CAR
-from sim.scenario.lamps import LOW_BEAM, Headlamps, StreetLamp, regulation_table
+from sim.scenario.lamps import LOW_BEAM, UP, Headlamps, StreetLamp, regulation_table
 from sim.scenario.lighting import NIGHT_AMBIENT_LUX, NIGHT_FULL_SCALE_LUX, PRESETS
 from sim.scenario.spec import MannequinSpec, SceneSpec
 from sim.sensor.readout import photometric_light
@@ -182,16 +182,6 @@ def ground_points(scene: Scene) -> tuple[np.ndarray, np.ndarray]:
     return origin + t[..., None] * rays, down
 
 
-def beam_intensity(beam: Headlamps, towards: np.ndarray) -> np.ndarray:
-    """Candela towards unit vectors (..., 3) in the car's frame (x ahead, y left, z up):
-    the sum of the cones that contain them, as Headlamps.intensity (vectorised)."""
-    out = np.zeros(towards.shape[:-1])
-    for spot in beam.spots:
-        inside = towards @ np.array(spot.direction()) >= math.cos(math.radians(spot.cutoff_deg))
-        out += np.where(inside, spot.intensity_cd, 0.0)
-    return out
-
-
 def lux_from_beam(
     points: np.ndarray, normal: np.ndarray, beam: Headlamps, beam_x: float
 ) -> np.ndarray:
@@ -200,20 +190,7 @@ def lux_from_beam(
     d = points - np.array([beam_x, 0.0, beam.height])
     r = np.linalg.norm(d, axis=-1)
     cos = np.maximum(-(d @ normal), 0.0) / r
-    return beam_intensity(beam, d / r[..., None]) * cos / r**2
-
-
-def lux_from_lamp(points: np.ndarray, normal: np.ndarray, lamp: StreetLamp) -> np.ndarray:
-    """Lux a street lamp puts on surfaces at `points` facing `normal` (its cone only)."""
-    if not lamp.on:
-        return np.zeros(points.shape[:-1])
-    d = points - np.array([lamp.x, lamp.y, lamp.height])
-    r = np.linalg.norm(d, axis=-1)
-    inside = -d[..., 2] / r >= math.cos(math.radians(lamp.cutoff_deg))
-    return np.where(inside, lamp.intensity_cd * np.maximum(-(d @ normal), 0.0) / r**3, 0.0)
-
-
-UP = np.array([0.0, 0.0, 1.0])
+    return beam.intensity_towards(d / r[..., None]) * cos / r**2
 
 
 def predicted_lux(scene: Scene, face_x: float, source: Source) -> np.ndarray:
@@ -227,7 +204,7 @@ def predicted_lux(scene: Scene, face_x: float, source: Source) -> np.ndarray:
     if source.beam is not None:
         lux += lux_from_beam(points, normal, source.beam, FRONT)
     if source.lamp:
-        lux += lux_from_lamp(points, normal, lamp_beside(face_x, source.lamp_on))
+        lux += lamp_beside(face_x, source.lamp_on).illuminance_on(points, normal)
     return lux
 
 
@@ -415,7 +392,7 @@ def road_region(scene: Scene, renderer: SceneRenderer, light: str) -> tuple[np.n
     if light == LAMP:
         foot = np.array([FRONT + ROAD_DISTANCE, ROAD_LAMP_Y])
         region = seen & (np.hypot(*(points[..., :2] - foot).transpose(2, 0, 1)) < ROAD_RADIUS)
-        lux = lux_from_lamp(points, UP, StreetLamp(FRONT + ROAD_DISTANCE, ROAD_LAMP_Y))
+        lux = StreetLamp(FRONT + ROAD_DISTANCE, ROAD_LAMP_Y).illuminance_on(points, UP)
     else:
         ahead = points[..., 0] - FRONT
         region = seen & (ahead > BEAM_FROM) & (ahead < BEAM_TO)
@@ -524,7 +501,7 @@ def street_saturation(
     grid = np.stack([*np.meshgrid(xs, ys), np.zeros((len(ys), len(xs)))], -1)
     lux = np.full(grid.shape[:2], NIGHT_AMBIENT_LUX)
     for lamp in lamps:
-        lux += lux_from_lamp(grid, UP, lamp)
+        lux += lamp.illuminance_on(grid, UP)
     if beam_x is not None:
         lux += lux_from_beam(grid, UP, LOW_BEAM, beam_x)
     reach = round(CORNER_REACH / RASTER_STEP)

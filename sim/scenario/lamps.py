@@ -34,10 +34,13 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
+import numpy as np
+
 CUT_OFF_DEG = 0.57  # the low beam's cut-off below the horizon (UN R112: 1 % down)
 LAMP_HEIGHT = 5.0  # m, the published night roads' lamps
 LAMP_INTENSITY_CD = 1600.0
 LAMP_CUTOFF_DEG = 75.0
+UP = np.array([0.0, 0.0, 1.0])  # the ground's normal
 
 
 @dataclass(frozen=True)
@@ -53,13 +56,17 @@ class StreetLamp:
 
     def illuminance(self, x: float, y: float) -> float:
         """Lux on the ground (horizontal) at (x, y)."""
+        return float(self.illuminance_on(np.array([x, y, 0.0]), UP))
+
+    def illuminance_on(self, points: np.ndarray, normal: np.ndarray) -> np.ndarray:
+        """Lux on surfaces at `points` (..., 3) facing `normal`: I / d^2 times the cosine of
+        incidence, inside the lamp's cone."""
         if not self.on:
-            return 0.0
-        d2 = (x - self.x) ** 2 + (y - self.y) ** 2 + self.height**2
-        cos_t = self.height / math.sqrt(d2)
-        if cos_t < math.cos(math.radians(self.cutoff_deg)):
-            return 0.0
-        return self.intensity_cd * cos_t / d2
+            return np.zeros(np.shape(points)[:-1])
+        d = np.asarray(points, dtype=float) - np.array([self.x, self.y, self.height])
+        r = np.linalg.norm(d, axis=-1)
+        inside = -d[..., 2] / r >= math.cos(math.radians(self.cutoff_deg))
+        return np.where(inside, self.intensity_cd * np.maximum(-(d @ normal), 0.0) / r**3, 0.0)
 
 
 @dataclass(frozen=True)
@@ -71,12 +78,6 @@ class Spot:
     right_deg: float
     cutoff_deg: float
     intensity_cd: float
-
-    def contains(self, down_deg: float, right_deg: float) -> bool:
-        """Whether the direction (down, right in degrees) lies inside the cone."""
-        a, b = _unit(self.down_deg, self.right_deg), _unit(down_deg, right_deg)
-        cos_angle = sum(p * q for p, q in zip(a, b, strict=True))
-        return cos_angle >= math.cos(math.radians(self.cutoff_deg))
 
     def direction(self) -> tuple[float, float, float]:
         """The axis in the car's frame (x forward, y left, z up)."""
@@ -97,8 +98,18 @@ class Headlamps:
     height: float = 0.65  # m, a passenger car's headlamp centres (UN R48: 0.5-1.2 m)
 
     def intensity(self, down_deg: float, right_deg: float) -> float:
-        """Candela towards a direction: the sum of the cones that contain it."""
-        return sum(s.intensity_cd for s in self.spots if s.contains(down_deg, right_deg))
+        """Candela towards a direction (degrees down and right): the sum of the cones that
+        contain it."""
+        return float(self.intensity_towards(np.array(_unit(down_deg, right_deg))))
+
+    def intensity_towards(self, towards: np.ndarray) -> np.ndarray:
+        """Candela towards unit vectors (..., 3) in the car's frame (x ahead, y left, z up)."""
+        out = np.zeros(np.shape(towards)[:-1])
+        for spot in self.spots:
+            axis = np.array(spot.direction())
+            inside = towards @ axis >= math.cos(math.radians(spot.cutoff_deg))
+            out = out + np.where(inside, spot.intensity_cd, 0.0)
+        return out
 
 
 def _cone_below_cut_off(half_angle: float, right_deg: float, intensity: float) -> Spot:

@@ -23,7 +23,7 @@ import mujoco
 import numpy as np
 
 from monopic.camera import CameraModel
-from sim.scenario.lamps import StreetLamp
+from sim.scenario.lamps import UP, StreetLamp
 from sim.world.entities.base import Entity, Moment
 
 MAX_LIGHTS = 8  # the classic renderer's, the headlight included
@@ -120,9 +120,9 @@ class StreetLamps(Entity):
             seen = (ahead > 1.0) & (np.abs(np.arctan2(side, ahead)) < self.half_fov + 0.1)
             if not seen.any():
                 continue
-            d2 = dx**2 + dy**2 + lamp.height**2
-            e = lamp.intensity_cd * lamp.height / d2**1.5
-            scores[k] = float(np.sum(e[seen] / np.maximum(dx[seen] ** 2 + dy[seen] ** 2, 9.0)))
+            ground = np.stack([px[seen], py[seen], np.zeros(int(seen.sum()))], axis=-1)
+            e = lamp.illuminance_on(ground, UP)
+            scores[k] = float(np.sum(e / np.maximum(dx[seen] ** 2 + dy[seen] ** 2, 9.0)))
         return scores
 
     def place(self, model: mujoco.MjModel, data: mujoco.MjData, moment: Moment) -> None:
