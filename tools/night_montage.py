@@ -26,6 +26,7 @@ import numpy as np
 from monopic.output import atomic_path
 from monopic.overlay import draw
 from monopic.pipeline import Variant
+from sim.runs.aeb import ahead_of_front
 from sim.runs.closed_loop import POLICY, policy_pipeline
 from sim.runs.loop import Listener, LoopFrame, OnBoard, run_loop
 from sim.scenario.ncap import Draw, GridPoint, load_car, load_protocol, scenario_for
@@ -46,8 +47,7 @@ class Grab(Listener):
     panels: dict[float, np.ndarray] = field(default_factory=dict)
 
     def frame(self, frame: LoopFrame) -> None:
-        person = frame.truth.pedestrian
-        ahead = float(np.hypot(*person.position_robot)) - self.front
+        ahead = ahead_of_front(frame.truth, self.front)
         for d in DISTANCES_M:
             if d in self.panels or ahead > d:
                 continue

@@ -447,15 +447,17 @@ def detection_by_band(
     rows: Sequence[dict[str, Any]], policy: str
 ) -> dict[str, list[tuple[int, int]]] | None:
     """{half: [(found, in sight) per distance band]} over the grid runs of the points run
-    both by day and at night (the night test's key is the day test's + "-night"), from
-    each run's per-frame SightLog; None when no point was run in both halves."""
+    both by day and at night (the same calculator scenario, "CPNA day" and "CPNA night",
+    function, speed and impact), from each run's per-frame SightLog; None when no point
+    was run in both halves."""
     from sim.analysis.ncap_score import half_of
 
     runs = [r for r in rows if r["policy"] == policy and r["role"] == GRID
             and r["outcome"].get("target_found")]  # fmt: skip
 
     def key(r: dict[str, Any]) -> tuple[str, str, float, float]:
-        return (r["test"].removesuffix("-night"), r["function"], r["speed_kmh"], r["impact"])
+        scenario = r["load_case"].split(" ")[0]
+        return (scenario, r["function"], r["speed_kmh"], r["impact"])
 
     halves = {h: {key(r) for r in runs if half_of(r["load_case"]) == h} for h in ("day", "night")}
     both = halves["day"] & halves["night"]

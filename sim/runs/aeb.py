@@ -50,7 +50,7 @@ from sim.runs.latency import AppliedLatency
 from sim.runs.loop import Listener, LoopFrame, OnBoard, Progress, run_loop
 from sim.runs.run_spec import ONE
 from sim.scenario.spec import Scenario
-from sim.world.ground_truth import pedestrian_passed
+from sim.world.ground_truth import GroundTruth, pedestrian_passed
 from sim.world.render import RenderContext
 from sim.world.warned_for import WarnedFor, braked_wrong, target_found
 from sim.world.world import World, WorldStep
@@ -168,6 +168,11 @@ class PitchLog(Listener):
 SEEN = 0.5  # share of the target's landmarks in the image and unoccluded: in sight
 
 
+def ahead_of_front(truth: GroundTruth, front: float) -> float:
+    """m from the car's front (`front` m ahead of its reference point) to the target."""
+    return max(0.0, float(np.hypot(*truth.pedestrian.position_robot)) - front)
+
+
 @dataclass
 class SightLog(Listener):
     """Per frame: whether the target was in sight, and found by the pipeline, and how far
@@ -183,8 +188,7 @@ class SightLog(Listener):
             self.found.append(-1)
         else:
             self.found.append(int(target_found(frame.results.get(POLICY), frame.truth)))
-        ahead = float(np.hypot(*person.position_robot)) - self.front
-        self.range_m.append(round(max(0.0, ahead), 2))
+        self.range_m.append(round(ahead_of_front(frame.truth, self.front), 2))
 
 
 @dataclass(frozen=True)
