@@ -74,16 +74,17 @@ def scenario_entities(scenario: Scenario, t_end: float) -> list[Entity]:
     ]
     planned = len(scenario.planned)
     crowd = [CrowdDirector(scenario, people[planned:], t_end)] if scenario.crowd else []
+    robot, camera = scenario.robot, scenario.robot.camera.model()
     return [
         *parked_cars(scenario.scene),
         *lights(
             scenario.scene.lighting,
             scenario.scene.lamps,
-            scenario.robot.camera.model(),
-            scenario.robot.headlamps,
-            scenario.robot.length / 2,
-        ),
-        RobotBody(scenario.robot.camera.model(), scenario.robot),
+            camera,
+            robot.headlamps,
+            robot.length / 2,
+        ),  # fmt: skip
+        RobotBody(camera, robot),
         *crowd,
         *people,
     ]
